@@ -1,0 +1,252 @@
+"""Build a :class:`Model` from links and joints (the graph form every loader produces).
+
+The builder checks the graph (duplicate or missing names, several roots, two parents, cycles,
+all without recursion), orders the bodies depth first (children in the order their joints
+were added, as URDF parsers do), merges fixed joints into their parent body with the
+parallel-axis theorem and keeps every merged link as a frame.
+
+Example::
+
+    b = ModelBuilder("arm")
+    b.add_link("base")
+    b.add_link("link1", mass=1.0, com=(0.5, 0, 0), inertia=np.diag([0, 0.1, 0.1]))
+    b.add_joint("j1", "revolute", "base", "link1", axis=(0, 0, 1))
+    model = b.build()
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import joints as J
+from .errors import RobodynWarning
+from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from
+from .spatial import inertia_act
+
+JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "fixed": None}
+
+
+def rpy_to_matrix(rpy) -> np.ndarray:
+    """Rotation of URDF roll-pitch-yaw angles: extrinsic X-Y-Z, ``R = Rz(y) Ry(p) Rx(r)``."""
+    r, p, y = (float(a) for a in rpy)
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+        [-sp, cp * sr, cp * cr],
+    ])
+
+
+@dataclass
+class _Link:
+    name: str
+    theta: np.ndarray
+    where: str
+
+
+@dataclass
+class _Joint:
+    name: str
+    type: str
+    parent: str
+    child: str
+    R: np.ndarray
+    p: np.ndarray
+    axis: np.ndarray
+    limits: dict = field(default_factory=dict)
+    where: str = ""
+
+
+class ModelBuilder:
+    """Collects links and joints, then :meth:`build` returns the immutable :class:`Model`."""
+
+    def __init__(self, name: str = "robot", gravity=(0.0, 0.0, -9.81), source: str = "<model>",
+                 physical: str = "error"):
+        """``physical="error"`` rejects unphysical link inertias with a :class:`ModelError`;
+        ``physical="warn"`` keeps them as given and warns (for descriptions known to carry
+        such values, e.g. some published URDFs)."""
+        if physical not in ("error", "warn"):
+            raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+        self.physical = physical
+        self.name = name
+        self.gravity = np.asarray(gravity, dtype=float)
+        self.source = source
+        self._links: dict[str, _Link] = {}
+        self._joints: list[_Joint] = []
+
+    def add_link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None,
+                 inertia_rotation=None, where: str | None = None) -> None:
+        """A rigid body: ``mass`` (kg), ``com`` (3,) in the link frame, ``inertia`` (3, 3) about
+        the centre of mass in axes rotated by ``inertia_rotation`` from the link frame
+        (applied as ``R I R^T``)."""
+        where = where or f"{self.source}: link {name!r}"
+        if name in self._links:
+            raise ModelError(f"{where}: duplicate link name {name!r} (first defined at {self._links[name].where})")
+        mass = float(mass)
+        com = np.asarray(com, dtype=float).reshape(3)
+        Ic = np.zeros((3, 3)) if inertia is None else np.asarray(inertia, dtype=float).reshape(3, 3)
+        if not np.all(np.isfinite(Ic)) or not np.isfinite(mass) or not np.all(np.isfinite(com)):
+            raise ModelError(f"{where}: mass, centre of mass and inertia must be finite")
+        if np.abs(Ic - Ic.T).max() > 1e-9 * max(np.abs(Ic).max(), 1e-300):
+            raise ModelError(f"{where}: inertia matrix is not symmetric")
+        if inertia_rotation is not None:
+            Rr = np.asarray(inertia_rotation, dtype=float)
+            Ic = Rr @ Ic @ Rr.T
+        theta = inertial_parameters_from(mass, com, Ic)
+        self._check_physical(theta, where)
+        self._links[name] = _Link(name, theta, where)
+
+    def _check_physical(self, theta, where: str) -> None:
+        if self.physical == "warn" and np.all(np.isfinite(theta)) and theta[0] >= 0:
+            try:
+                check_inertial_parameters(theta, where)
+            except ModelError as e:
+                warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=4)
+            return
+        try:
+            check_inertial_parameters(theta, where)
+        except ModelError as e:
+            raise ModelError(f"{e} (load with physical='warn' to keep it anyway)") from None
+
+    def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
+                  rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
+                  upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
+                  armature=0.0, where: str | None = None) -> None:
+        """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
+        in the parent link frame and the child frame coincides with it at ``q = 0``."""
+        where = where or f"{self.source}: joint {name!r}"
+        if type not in JOINT_TYPES:
+            raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted(JOINT_TYPES)}")
+        R = rpy_to_matrix(rpy) if rotation is None else np.asarray(rotation, dtype=float)
+        p = np.asarray(xyz, dtype=float).reshape(3)
+        ax = np.asarray(axis, dtype=float).reshape(3)
+        for what, a in (("origin", np.concatenate([p, R.ravel()])), ("axis", ax)):
+            if not np.all(np.isfinite(a)):
+                raise ModelError(f"{where}: {what} is not finite")
+        if type != "fixed":
+            n = np.linalg.norm(ax)
+            if n < 1e-12:
+                raise ModelError(f"{where}: joint axis is zero")
+            ax = ax / n
+        if type == "continuous":
+            lower, upper = -np.inf, np.inf
+        limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
+                      effort=float(effort), damping=float(damping), friction=float(friction),
+                      armature=float(armature))
+        for k, val in limits.items():
+            if np.isnan(val):
+                raise ModelError(f"{where}: {k} is NaN")
+            if k not in ("lower", "upper") and (val < 0 or (k in ("damping", "friction", "armature") and not np.isfinite(val))):
+                raise ModelError(f"{where}: {k} must be finite and >= 0, got {val}")
+        if limits["lower"] > limits["upper"]:
+            raise ModelError(f"{where}: lower limit {lower} exceeds upper limit {upper}")
+        self._joints.append(_Joint(name, type, parent, child, R, p, ax, limits, where))
+
+    # ---------------------------------------------------------------------------------
+    def _check_graph(self) -> tuple[str, dict[str, list[_Joint]]]:
+        """Return the root link and the child joints of each link, or raise ModelError."""
+        if not self._links:
+            raise ModelError(f"{self.source}: no links")
+        seen_joint: dict[str, _Joint] = {}
+        parent_joint: dict[str, _Joint] = {}
+        children: dict[str, list[_Joint]] = {name: [] for name in self._links}
+        for jt in self._joints:
+            if jt.name in seen_joint:
+                raise ModelError(f"{jt.where}: duplicate joint name {jt.name!r} (first at {seen_joint[jt.name].where})")
+            seen_joint[jt.name] = jt
+            for role, link in (("parent", jt.parent), ("child", jt.child)):
+                if link not in self._links:
+                    raise ModelError(f"{jt.where}: {role} link {link!r} does not exist")
+            if jt.parent == jt.child:
+                raise ModelError(f"{jt.where}: joint connects link {jt.child!r} to itself")
+            if jt.child in parent_joint:
+                raise ModelError(
+                    f"{jt.where}: link {jt.child!r} has two parents (joints "
+                    f"{parent_joint[jt.child].name!r} and {jt.name!r})"
+                )
+            parent_joint[jt.child] = jt
+            children[jt.parent].append(jt)
+        roots = [name for name in self._links if name not in parent_joint]
+        if len(roots) > 1:
+            raise ModelError(f"{self.source}: several root links {roots}; a robot is one tree")
+        if not roots:
+            raise ModelError(f"{self.source}: no root link: the joints form a cycle")
+        # every link has at most one parent, so links unreachable from the root lie on cycles
+        reached, stack = {roots[0]}, [roots[0]]
+        while stack:
+            for jt in children[stack.pop()]:
+                reached.add(jt.child)
+                stack.append(jt.child)
+        if len(reached) != len(self._links):
+            cyc = sorted(set(self._links) - reached)
+            raise ModelError(f"{self.source}: the joints form a cycle through links {cyc}")
+        return roots[0], children
+
+    def build(self, floating_base: bool = False) -> Model:
+        """The :class:`Model`; a floating base adds a free joint ``root_joint`` at the root."""
+        root, children = self._check_graph()
+        parent, jtype, axis, XR, Xp, theta = [], [], [], [], [], []
+        names, jnames, dofs = [], [], []
+        frames: list[tuple[str, int, np.ndarray, np.ndarray]] = []
+
+        def new_body(par, code, ax, R, p, name, jname, lim):
+            parent.append(par)
+            jtype.append(code)
+            axis.append(ax)
+            XR.append(R)
+            Xp.append(p)
+            theta.append(np.zeros(10))
+            names.append(name)
+            jnames.append(jname)
+            dofs.extend([lim] * int(J.NV[code]))
+            return len(parent) - 1
+
+        free = dict(lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0, armature=0.0)
+        if floating_base:
+            b = new_body(-1, J.FREE, np.zeros(3), np.eye(3), np.zeros(3), root, "root_joint", free)
+            place = {root: (b, np.eye(3), np.zeros(3))}
+        else:
+            place = {root: (-1, np.eye(3), np.zeros(3))}
+            frames.append((root, -1, np.eye(3), np.zeros(3)))
+        order = [root]
+        stack = list(reversed(children[root]))
+        while stack:
+            jt = stack.pop()
+            b, R, p = place[jt.parent]
+            Rj, pj = R @ jt.R, p + R @ jt.p
+            if jt.type == "fixed":
+                place[jt.child] = (b, Rj, pj)
+                frames.append((jt.child, b, Rj, pj))
+            else:
+                nb = new_body(b, JOINT_TYPES[jt.type], jt.axis, Rj, pj, jt.child, jt.name, jt.limits)
+                place[jt.child] = (nb, np.eye(3), np.zeros(3))
+            order.append(jt.child)
+            stack.extend(reversed(children[jt.child]))
+        for link in order:
+            b, R, p = place[link]
+            if b < 0:
+                continue  # carried by the fixed world
+            out = np.empty(10)
+            inertia_act(R, p, self._links[link].theta, out)
+            theta[b] += out
+        for i, t in enumerate(theta):
+            self._check_physical(t, f"{self.source}: body {names[i]!r} (with the links merged into it)")
+
+        def col(key):
+            return np.array([d[key] for d in dofs], dtype=float)
+
+        nb = len(parent)
+        return Model(
+            parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)),
+            X_tree_R=np.reshape(XR, (nb, 3, 3)), X_tree_p=np.reshape(Xp, (nb, 3)),
+            inertia=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
+            gravity=self.gravity, lower=col("lower"), upper=col("upper"),
+            velocity_limit=col("velocity"), effort_limit=col("effort"), damping=col("damping"),
+            coulomb=col("friction"), armature=col("armature"),
+            frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
+            frame_R=np.reshape([f[2] for f in frames], (len(frames), 3, 3)),
+            frame_p=np.reshape([f[3] for f in frames], (len(frames), 3)), name=self.name,
+        )

@@ -1,0 +1,7 @@
+"""Loaders that build a :class:`~robodyn.model.Model` from robot descriptions."""
+
+from .dh import DHLink, dh_transform, from_dh
+from .urdf import load_urdf
+from ..errors import RobodynWarning
+
+__all__ = ["DHLink", "dh_transform", "from_dh", "load_urdf", "RobodynWarning"]

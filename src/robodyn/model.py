@@ -1,0 +1,387 @@
+"""The robot model: an immutable set of flat arrays indexed by body.
+
+A model is a kinematic tree of ``nbodies`` rigid bodies. Body ``i`` hangs from body
+``parent[i] < i`` (``-1`` is the fixed world) through one joint whose frame sits at the fixed
+placement ``X_tree[i]`` in the parent body's frame. Fixed joints do not appear: the loaders
+merge them into the parent body and keep the merged links as *frames*.
+
+Configuration ``q`` (nq,) and velocity ``v`` (nv,) stack the joints in body order; body ``i``
+owns ``q[idx_q[i]:idx_q[i] + nq_i]`` and ``v[idx_v[i]:idx_v[i] + nv_i]`` (see
+:mod:`robodyn.joints`). A floating base is body 0 with a free joint:
+``q = [x, y, z, qx, qy, qz, qw, joints...]`` and ``v = [v_lin, omega, joints...]``, the base
+velocities in the base frame.
+
+Inertial parameters, 10 per body about the body frame origin in the body frame:
+``[m, m*cx, m*cy, m*cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``.
+"""
+
+from __future__ import annotations
+
+from typing import Sequence
+
+import numpy as np
+
+from . import joints as J
+
+
+from .errors import ModelError
+
+
+# Tolerances of the physical-consistency checks of inertias: relative to the largest principal
+# moment, with an absolute floor (kg m^2) for the round-off of bodies with (almost) no inertia.
+INERTIA_RTOL = 1e-6
+INERTIA_ATOL = 1e-12
+
+
+def _readonly(a, dtype=float):
+    a = np.array(a, dtype=dtype, copy=True)
+    a.flags.writeable = False
+    return a
+
+
+def inertial_parameters_from(mass: float, com, inertia_com) -> np.ndarray:
+    """10 inertial parameters about the frame origin from mass, centre of mass and the 3 x 3
+    inertia about the centre of mass (all in the same frame), by the parallel-axis theorem."""
+    c = np.asarray(com, dtype=float)
+    Ic = np.asarray(inertia_com, dtype=float)
+    Io = Ic + mass * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+    h = mass * c
+    return np.array([mass, h[0], h[1], h[2], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
+
+
+def inertia_about_origin(theta) -> np.ndarray:
+    """3 x 3 rotational inertia about the frame origin from 10 parameters."""
+    t = theta
+    return np.array([[t[4], t[5], t[7]], [t[5], t[6], t[8]], [t[7], t[8], t[9]]], dtype=float)
+
+
+def check_inertial_parameters(theta, where: str) -> None:
+    """Raise :class:`ModelError` unless ``theta`` is a physically consistent rigid body.
+
+    Checks: finite values, mass >= 0, a massless body has no first moment and no inertia,
+    the inertia about the centre of mass is positive semi-definite and its principal moments
+    satisfy the triangle inequality ``I1 + I2 >= I3`` (tolerances ``INERTIA_RTOL`` relative to
+    the largest principal moment and ``INERTIA_ATOL`` absolute).
+    """
+    theta = np.asarray(theta, dtype=float)
+    if not np.all(np.isfinite(theta)):
+        raise ModelError(f"{where}: inertial parameters are not finite: {theta.tolist()}")
+    m = theta[0]
+    Io = inertia_about_origin(theta)
+    scale = max(np.abs(Io).max(), 1e-300)
+    if m < 0:
+        raise ModelError(f"{where}: negative mass {m}")
+    if m == 0:
+        if np.abs(theta[1:]).max() > 0:
+            raise ModelError(f"{where}: zero mass with non-zero first moment or inertia")
+        return
+    c = theta[1:4] / m
+    Ic = Io - m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+    eig = np.linalg.eigvalsh(Ic)
+    tol = max(INERTIA_RTOL * np.abs(eig).max(), 1e-12 * scale, INERTIA_ATOL)
+    if eig[0] < -tol:
+        raise ModelError(
+            f"{where}: inertia about the centre of mass is not positive semi-definite "
+            f"(principal moments {eig.tolist()})"
+        )
+    if eig[0] + eig[1] < eig[2] - tol:
+        raise ModelError(
+            f"{where}: principal moments of inertia {eig.tolist()} violate the triangle "
+            "inequality I1 + I2 >= I3"
+        )
+
+
+class Model:
+    """Immutable rigid-body tree (see the module docstring for the layout).
+
+    Per-body arrays (``nb = nbodies``): ``parent`` (nb,), ``joint_type`` (nb,),
+    ``joint_axis`` (nb, 3), ``X_tree_R`` (nb, 3, 3) and ``X_tree_p`` (nb, 3) (joint frame in
+    the parent body frame), ``inertia`` (nb, 10), ``idx_q`` (nb,), ``idx_v`` (nb,).
+    Per-dof arrays (nv,): ``lower``, ``upper`` (position limits of 1-dof joints, +-inf for free
+    joints), ``velocity_limit``, ``effort_limit``, ``damping`` (viscous, N m s/rad), ``coulomb``
+    (N m), ``armature`` (reflected rotor inertia, kg m^2). Frames (nf): ``frame_names``,
+    ``frame_body`` (-1 for the world), ``frame_R`` (nf, 3, 3), ``frame_p`` (nf, 3).
+    ``gravity`` (3,) in the world frame.
+    """
+
+    __slots__ = (
+        "name", "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia",
+        "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
+        "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
+        "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
+        "physical", "_kernel", "_frame_index", "_dof_variants",
+    )
+
+    def __init__(
+        self,
+        *,
+        parent,
+        joint_type,
+        joint_axis,
+        X_tree_R,
+        X_tree_p,
+        inertia,
+        link_names: Sequence[str],
+        body_joint_names: Sequence[str],
+        gravity=(0.0, 0.0, -9.81),
+        lower=None,
+        upper=None,
+        velocity_limit=None,
+        effort_limit=None,
+        damping=None,
+        coulomb=None,
+        armature=None,
+        coulomb_smoothing: float = 0.0,
+        frame_names: Sequence[str] = (),
+        frame_body=(),
+        frame_R=(),
+        frame_p=(),
+        name: str = "robot",
+        physical: str = "error",
+    ):
+        setattr_ = object.__setattr__
+        parent = np.asarray(parent, dtype=np.int64).reshape(-1)
+        nb = parent.shape[0]
+        jt = np.asarray(joint_type, dtype=np.int64).reshape(-1)
+        if jt.shape != (nb,):
+            raise ModelError(f"joint_type must have shape ({nb},), got {jt.shape}")
+        for i in range(nb):
+            if not (-1 <= parent[i] < i):
+                raise ModelError(f"body {i}: parent index {parent[i]} must satisfy -1 <= parent < {i}")
+            if not 0 <= jt[i] < len(J.NAMES):
+                raise ModelError(f"body {i}: unknown joint type code {jt[i]}")
+            if jt[i] == J.FREE and parent[i] != -1:
+                raise ModelError(f"body {i}: a free joint must attach to the world")
+        nq_i = J.NQ[jt] if nb else np.zeros(0, np.int64)
+        nv_i = J.NV[jt] if nb else np.zeros(0, np.int64)
+        idx_q = np.concatenate([[0], np.cumsum(nq_i)[:-1]]).astype(np.int64) if nb else nq_i
+        idx_v = np.concatenate([[0], np.cumsum(nv_i)[:-1]]).astype(np.int64) if nb else nv_i
+        nq, nv = int(nq_i.sum()), int(nv_i.sum())
+
+        def arr(x, shape, what, fill=0.0):
+            a = np.full(shape, fill, dtype=float) if x is None else np.asarray(x, dtype=float)
+            if a.shape != shape:
+                raise ModelError(f"{what} must have shape {shape}, got {a.shape}")
+            return a
+
+        axis = arr(joint_axis, (nb, 3), "joint_axis")
+        R = arr(X_tree_R, (nb, 3, 3), "X_tree_R")
+        p = arr(X_tree_p, (nb, 3), "X_tree_p")
+        theta = arr(inertia, (nb, 10), "inertia")
+        names = list(link_names)
+        jnames = list(body_joint_names)
+        if len(names) != nb or len(jnames) != nb:
+            raise ModelError(f"link_names and body_joint_names need {nb} entries")
+        for i in range(nb):
+            where = f"body {i} ({names[i]!r})"
+            for what, a in (("joint_axis", axis[i]), ("X_tree_R", R[i]), ("X_tree_p", p[i])):
+                if not np.all(np.isfinite(a)):
+                    raise ModelError(f"{where}: {what} is not finite")
+            if jt[i] in (J.REVOLUTE, J.PRISMATIC):
+                n = np.linalg.norm(axis[i])
+                if n < 1e-12:
+                    raise ModelError(f"{where}: joint axis is zero")
+                axis[i] = axis[i] / n
+            if np.abs(R[i] @ R[i].T - np.eye(3)).max() > 1e-9 or np.linalg.det(R[i]) < 0:
+                raise ModelError(f"{where}: X_tree_R is not a rotation matrix")
+            if physical == "error":
+                check_inertial_parameters(theta[i], where)
+            elif not (np.all(np.isfinite(theta[i])) and theta[i, 0] >= 0):
+                raise ModelError(f"{where}: inertial parameters must be finite with mass >= 0")
+        g = arr(gravity, (3,), "gravity")
+        if not np.all(np.isfinite(g)):
+            raise ModelError("gravity is not finite")
+
+        free_dof = np.zeros(nv, dtype=bool)
+        for i in range(nb):
+            if jt[i] == J.FREE:
+                free_dof[idx_v[i]:idx_v[i] + 6] = True
+        lo = arr(lower, (nv,), "lower", -np.inf)
+        hi = arr(upper, (nv,), "upper", np.inf)
+        lo[free_dof], hi[free_dof] = -np.inf, np.inf
+        dofs = {}
+        for key, val, fill in (("velocity_limit", velocity_limit, np.inf), ("effort_limit", effort_limit, np.inf),
+                               ("damping", damping, 0.0), ("coulomb", coulomb, 0.0), ("armature", armature, 0.0)):
+            a = arr(val, (nv,), key, fill)
+            if np.any(np.isnan(a)) or np.any(a < 0):
+                raise ModelError(f"{key} must be non-negative, got {a.tolist()}")
+            if key in ("damping", "coulomb", "armature") and not np.all(np.isfinite(a)):
+                raise ModelError(f"{key} must be finite, got {a.tolist()}")
+            dofs[key] = a
+        if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo > hi):
+            raise ModelError("joint position limits must satisfy lower <= upper")
+        if not (np.isfinite(coulomb_smoothing) and coulomb_smoothing >= 0):
+            raise ModelError(f"coulomb_smoothing must be finite and >= 0, got {coulomb_smoothing}")
+
+        fnames = list(frame_names)
+        nf = len(fnames)
+        fb = np.asarray(frame_body, dtype=np.int64).reshape(nf)
+        fR = arr(np.reshape(frame_R, (nf, 3, 3)) if nf else None, (nf, 3, 3), "frame_R")
+        fp = arr(np.reshape(frame_p, (nf, 3)) if nf else None, (nf, 3), "frame_p")
+        if np.any(fb < -1) or np.any(fb >= nb):
+            raise ModelError("frame_body indices out of range")
+        # every body is a frame too, under its own name
+        all_names = names + fnames
+        if len(set(all_names)) != len(all_names):
+            dup = sorted({n for n in all_names if all_names.count(n) > 1})
+            raise ModelError(f"duplicate link or frame names: {dup}")
+        one_dof = [jnames[i] for i in range(nb) if J.NV[jt[i]] == 1]
+        if len(set(one_dof)) != len(one_dof):
+            raise ModelError("duplicate joint names")
+
+        if physical not in ("error", "warn"):
+            raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+        setattr_(self, "physical", physical)
+        setattr_(self, "name", str(name))
+        setattr_(self, "parent", _readonly(parent, np.int64))
+        setattr_(self, "joint_type", _readonly(jt, np.int64))
+        setattr_(self, "joint_axis", _readonly(axis))
+        setattr_(self, "X_tree_R", _readonly(R))
+        setattr_(self, "X_tree_p", _readonly(p))
+        setattr_(self, "inertia", _readonly(theta))
+        setattr_(self, "idx_q", _readonly(idx_q, np.int64))
+        setattr_(self, "idx_v", _readonly(idx_v, np.int64))
+        setattr_(self, "nq", nq)
+        setattr_(self, "nv", nv)
+        setattr_(self, "link_names", tuple(names))
+        setattr_(self, "body_joint_names", tuple(jnames))
+        setattr_(self, "joint_names", tuple(one_dof))
+        setattr_(self, "lower", _readonly(lo))
+        setattr_(self, "upper", _readonly(hi))
+        for key, a in dofs.items():
+            setattr_(self, key, _readonly(a))
+        setattr_(self, "coulomb_smoothing", float(coulomb_smoothing))
+        setattr_(self, "gravity", _readonly(g))
+        setattr_(self, "frame_names", tuple(fnames))
+        setattr_(self, "frame_body", _readonly(fb, np.int64))
+        setattr_(self, "frame_R", _readonly(fR))
+        setattr_(self, "frame_p", _readonly(fp))
+        index = {n: i for i, n in enumerate(all_names)}
+        setattr_(self, "_frame_index", index)
+        setattr_(self, "_kernel", self._pack())
+        setattr_(self, "_dof_variants", {})
+
+    def __setattr__(self, key, value):
+        raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
+
+    # -- derived quantities ------------------------------------------------------------
+    @property
+    def nbodies(self) -> int:
+        return int(self.parent.shape[0])
+
+    @property
+    def floating_base(self) -> bool:
+        return bool(self.nbodies and self.joint_type[0] == J.FREE)
+
+    @property
+    def total_mass(self) -> float:
+        return float(self.inertia[:, 0].sum())
+
+    def inertial_parameters(self) -> np.ndarray:
+        """All inertial parameters, (10 * nbodies,), body after body (order in module doc)."""
+        return self.inertia.reshape(-1).copy()
+
+    def with_inertial_parameters(self, theta) -> "Model":
+        """A new model with the inertial parameters ``theta`` (10 * nbodies,)."""
+        theta = np.asarray(theta, dtype=float)
+        if theta.shape != (10 * self.nbodies,):
+            raise ValueError(f"theta: expected shape ({10 * self.nbodies},), got {theta.shape}")
+        return self.replace(inertia=theta.reshape(self.nbodies, 10))
+
+    def replace(self, **changes) -> "Model":
+        """A new model with some constructor arguments changed (validated again)."""
+        kw = {k: getattr(self, k) for k in (
+            "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "link_names",
+            "body_joint_names", "gravity", "lower", "upper", "velocity_limit", "effort_limit",
+            "damping", "coulomb", "armature", "coulomb_smoothing", "frame_names", "frame_body",
+            "frame_R", "frame_p", "name", "physical")}
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise TypeError(f"unknown model fields: {sorted(unknown)}")
+        kw.update(changes)
+        return Model(**kw)
+
+    def frame_index(self, name: str) -> tuple[int, np.ndarray, np.ndarray]:
+        """``(body, R, p)``: the body a link/frame name is attached to and its placement."""
+        if not isinstance(name, str):
+            raise TypeError(f"frame name must be a string, got {type(name).__name__}")
+        try:
+            k = self._frame_index[name]
+        except KeyError:
+            raise ValueError(f"unknown link or frame {name!r}; known: {sorted(self._frame_index)}") from None
+        if k < self.nbodies:
+            return k, np.eye(3), np.zeros(3)
+        k -= self.nbodies
+        return int(self.frame_body[k]), self.frame_R[k], self.frame_p[k]
+
+    def body_index(self, body) -> int:
+        """Index of a body given by index or by the name of a link merged into it."""
+        if isinstance(body, (int, np.integer)):
+            if not -self.nbodies <= body < self.nbodies:
+                raise ValueError(f"body index {body} out of range for {self.nbodies} bodies")
+            return int(body) % self.nbodies
+        b, _, _ = self.frame_index(body)
+        return b
+
+    # -- kernel layout -----------------------------------------------------------------
+    def _pack(self):
+        """Arrays handed to the compiled kernels (few arguments, contiguous).
+
+        ``ints`` (nb, 5): parent, joint type, idx_q, idx_v, nv of the joint;
+        ``body`` (nb, 25): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10);
+        ``S`` (nv, 6): motion subspace columns in the child frame;
+        ``dof`` (nv, 3): armature, damping, Coulomb friction.
+        """
+        nb = self.nbodies
+        ints = np.zeros((nb, 5), dtype=np.int64)
+        ints[:, 0] = self.parent
+        ints[:, 1] = self.joint_type
+        ints[:, 2] = self.idx_q
+        ints[:, 3] = self.idx_v
+        ints[:, 4] = J.NV[self.joint_type] if nb else 0
+        body = np.zeros((nb, 25))
+        body[:, 0:9] = self.X_tree_R.reshape(nb, 9)
+        body[:, 9:12] = self.X_tree_p
+        body[:, 12:15] = self.joint_axis
+        body[:, 15:25] = self.inertia
+        S = np.zeros((self.nv, 6))
+        for i in range(nb):
+            k = self.idx_v[i]
+            Si = J.motion_subspace(int(self.joint_type[i]), self.joint_axis[i])
+            S[k:k + Si.shape[0]] = Si
+        dof = np.stack([self.armature, self.damping, self.coulomb], axis=1) if self.nv else np.zeros((0, 3))
+        for a in (ints, body, S, dof):
+            a.flags.writeable = False
+        return ints, np.ascontiguousarray(body), S, np.ascontiguousarray(dof)
+
+    def _dof(self, friction: bool, armature: bool) -> np.ndarray:
+        key = (bool(friction), bool(armature))
+        d = self._dof_variants.get(key)
+        if d is None:
+            d = self._kernel[3].copy()
+            if not armature:
+                d[:, 0] = 0.0
+            if not friction:
+                d[:, 1:] = 0.0
+            d.flags.writeable = False
+            self._dof_variants[key] = d
+        return d
+
+    # -- display -----------------------------------------------------------------------
+    def __repr__(self) -> str:
+        lines = [
+            f"Model {self.name!r}: nq={self.nq}, nv={self.nv}, {self.nbodies} bodies, "
+            f"total mass {self.total_mass:.4g} kg, "
+            f"{'floating' if self.floating_base else 'fixed'} base, gravity {self.gravity.tolist()}",
+            f"  {'#':>3} {'body':<24} {'joint':<24} {'type':<9} {'parent':<20} {'axis':<22} {'mass':>9}",
+        ]
+        for i in range(self.nbodies):
+            par = self.link_names[self.parent[i]] if self.parent[i] >= 0 else "world"
+            ax = "" if self.joint_type[i] == J.FREE else np.array2string(self.joint_axis[i], precision=3, suppress_small=True)
+            lines.append(
+                f"  {i:>3} {self.link_names[i]:<24} {self.body_joint_names[i]:<24} "
+                f"{J.NAMES[self.joint_type[i]]:<9} {par:<20} {ax:<22} {self.inertia[i, 0]:>9.4g}"
+            )
+        if self.frame_names:
+            lines.append(f"  frames: {', '.join(self.frame_names)}")
+        return "\n".join(lines)

@@ -1,0 +1,1 @@
+"""Built-in robots: ``load(name)`` and ``names()``."""

@@ -1,0 +1,344 @@
+"""Small spatial-algebra helpers for the compiled kernels.
+
+Conventions used inside the kernels (never exposed by the public API):
+
+* A spatial **motion** vector (twist, acceleration, joint axis) is ``m = [v; w]``:
+  linear part first (the velocity of the point at the frame origin), angular part last.
+* A spatial **force** vector (wrench) is ``f = [f; n]``: force first, moment about the frame
+  origin last.
+* A **placement** ``aMb = (R, p)`` gives frame ``b`` in frame ``a``: ``R`` (3, 3) rotates
+  ``b`` coordinates into ``a`` coordinates and ``p`` (3,) is the origin of ``b`` in ``a``.
+  ``act`` maps a vector from ``b`` coordinates to ``a`` coordinates, ``act_inv`` the reverse.
+* A rigid-body **inertia** is stored as its 10 inertial parameters about the frame origin,
+  in the order ``[m, hx, hy, hz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` with ``h = m c`` (first
+  moment) and ``I`` the rotational inertia about the origin (not the centre of mass).
+
+With this ordering the free-flyer velocity ``[v_lin, omega]`` of the public API is already
+a spatial motion vector, and wrenches are ``[force, torque]`` as users write them.
+
+Every helper writes into an output array passed by the caller, so that kernels allocate
+nothing in their loops. Reference: R. Featherstone, *Rigid Body Dynamics Algorithms*
+(RBDA), Springer 2008, chapter 2 (with the two halves of each vector swapped).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_JIT = dict(cache=True, fastmath=False, inline="always")
+
+
+@njit(**_JIT)
+def cross3(a, b, out):
+    """``out = a x b`` for 3-vectors (``out`` must not alias ``a`` or ``b``)."""
+    out[0] = a[1] * b[2] - a[2] * b[1]
+    out[1] = a[2] * b[0] - a[0] * b[2]
+    out[2] = a[0] * b[1] - a[1] * b[0]
+
+
+@njit(**_JIT)
+def rotation_axis_angle(axis, angle, R):
+    """Rodrigues' formula: rotation by ``angle`` about the unit ``axis``."""
+    x, y, z = axis[0], axis[1], axis[2]
+    c = np.cos(angle)
+    s = np.sin(angle)
+    t = 1.0 - c
+    R[0, 0] = t * x * x + c
+    R[0, 1] = t * x * y - s * z
+    R[0, 2] = t * x * z + s * y
+    R[1, 0] = t * x * y + s * z
+    R[1, 1] = t * y * y + c
+    R[1, 2] = t * y * z - s * x
+    R[2, 0] = t * x * z - s * y
+    R[2, 1] = t * y * z + s * x
+    R[2, 2] = t * z * z + c
+
+
+@njit(**_JIT)
+def rotation_from_quaternion(qx, qy, qz, qw, R):
+    """Rotation matrix of the unit quaternion ``(qx, qy, qz, qw)`` (scalar last)."""
+    R[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
+    R[0, 1] = 2.0 * (qx * qy - qz * qw)
+    R[0, 2] = 2.0 * (qx * qz + qy * qw)
+    R[1, 0] = 2.0 * (qx * qy + qz * qw)
+    R[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
+    R[1, 2] = 2.0 * (qy * qz - qx * qw)
+    R[2, 0] = 2.0 * (qx * qz - qy * qw)
+    R[2, 1] = 2.0 * (qy * qz + qx * qw)
+    R[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+
+
+@njit(**_JIT)
+def compose(Ra, pa, Rb, pb, R, p):
+    """``(R, p) = (Ra, pa) * (Rb, pb)``: ``R = Ra Rb``, ``p = pa + Ra pb``."""
+    for r in range(3):
+        p[r] = pa[r] + Ra[r, 0] * pb[0] + Ra[r, 1] * pb[1] + Ra[r, 2] * pb[2]
+        for c in range(3):
+            R[r, c] = Ra[r, 0] * Rb[0, c] + Ra[r, 1] * Rb[1, c] + Ra[r, 2] * Rb[2, c]
+
+
+@njit(**_JIT)
+def motion_act(R, p, m, out):
+    """Motion vector from child to parent coordinates: ``[R v + p x R w; R w]``."""
+    w0 = R[0, 0] * m[3] + R[0, 1] * m[4] + R[0, 2] * m[5]
+    w1 = R[1, 0] * m[3] + R[1, 1] * m[4] + R[1, 2] * m[5]
+    w2 = R[2, 0] * m[3] + R[2, 1] * m[4] + R[2, 2] * m[5]
+    v0 = R[0, 0] * m[0] + R[0, 1] * m[1] + R[0, 2] * m[2]
+    v1 = R[1, 0] * m[0] + R[1, 1] * m[1] + R[1, 2] * m[2]
+    v2 = R[2, 0] * m[0] + R[2, 1] * m[1] + R[2, 2] * m[2]
+    out[0] = v0 + p[1] * w2 - p[2] * w1
+    out[1] = v1 + p[2] * w0 - p[0] * w2
+    out[2] = v2 + p[0] * w1 - p[1] * w0
+    out[3] = w0
+    out[4] = w1
+    out[5] = w2
+
+
+@njit(**_JIT)
+def motion_act_inv(R, p, m, out):
+    """Motion vector from parent to child coordinates: ``[R^T (v - p x w); R^T w]``."""
+    u0 = m[0] - (p[1] * m[5] - p[2] * m[4])
+    u1 = m[1] - (p[2] * m[3] - p[0] * m[5])
+    u2 = m[2] - (p[0] * m[4] - p[1] * m[3])
+    w0, w1, w2 = m[3], m[4], m[5]
+    out[0] = R[0, 0] * u0 + R[1, 0] * u1 + R[2, 0] * u2
+    out[1] = R[0, 1] * u0 + R[1, 1] * u1 + R[2, 1] * u2
+    out[2] = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
+    out[3] = R[0, 0] * w0 + R[1, 0] * w1 + R[2, 0] * w2
+    out[4] = R[0, 1] * w0 + R[1, 1] * w1 + R[2, 1] * w2
+    out[5] = R[0, 2] * w0 + R[1, 2] * w1 + R[2, 2] * w2
+
+
+@njit(**_JIT)
+def force_act(R, p, f, out):
+    """Force vector from child to parent coordinates: ``[R f; R n + p x R f]``."""
+    f0 = R[0, 0] * f[0] + R[0, 1] * f[1] + R[0, 2] * f[2]
+    f1 = R[1, 0] * f[0] + R[1, 1] * f[1] + R[1, 2] * f[2]
+    f2 = R[2, 0] * f[0] + R[2, 1] * f[1] + R[2, 2] * f[2]
+    n0 = R[0, 0] * f[3] + R[0, 1] * f[4] + R[0, 2] * f[5]
+    n1 = R[1, 0] * f[3] + R[1, 1] * f[4] + R[1, 2] * f[5]
+    n2 = R[2, 0] * f[3] + R[2, 1] * f[4] + R[2, 2] * f[5]
+    out[0] = f0
+    out[1] = f1
+    out[2] = f2
+    out[3] = n0 + p[1] * f2 - p[2] * f1
+    out[4] = n1 + p[2] * f0 - p[0] * f2
+    out[5] = n2 + p[0] * f1 - p[1] * f0
+
+
+@njit(**_JIT)
+def force_act_inv(R, p, f, out):
+    """Force vector from parent to child coordinates: ``[R^T f; R^T (n - p x f)]``."""
+    u0 = f[3] - (p[1] * f[2] - p[2] * f[1])
+    u1 = f[4] - (p[2] * f[0] - p[0] * f[2])
+    u2 = f[5] - (p[0] * f[1] - p[1] * f[0])
+    f0, f1, f2 = f[0], f[1], f[2]
+    out[0] = R[0, 0] * f0 + R[1, 0] * f1 + R[2, 0] * f2
+    out[1] = R[0, 1] * f0 + R[1, 1] * f1 + R[2, 1] * f2
+    out[2] = R[0, 2] * f0 + R[1, 2] * f1 + R[2, 2] * f2
+    out[3] = R[0, 0] * u0 + R[1, 0] * u1 + R[2, 0] * u2
+    out[4] = R[0, 1] * u0 + R[1, 1] * u1 + R[2, 1] * u2
+    out[5] = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
+
+
+@njit(**_JIT)
+def motion_cross(m, n, out):
+    """Spatial cross product of motions, ``out = m x n = [w x v' + v x w'; w x w']``."""
+    v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
+    out[0] = w1 * n[2] - w2 * n[1] + v1 * n[5] - v2 * n[4]
+    out[1] = w2 * n[0] - w0 * n[2] + v2 * n[3] - v0 * n[5]
+    out[2] = w0 * n[1] - w1 * n[0] + v0 * n[4] - v1 * n[3]
+    out[3] = w1 * n[5] - w2 * n[4]
+    out[4] = w2 * n[3] - w0 * n[5]
+    out[5] = w0 * n[4] - w1 * n[3]
+
+
+@njit(**_JIT)
+def force_cross(m, f, out):
+    """Dual cross product, ``out = m x* f = [w x f; w x n + v x f]``."""
+    v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
+    out[0] = w1 * f[2] - w2 * f[1]
+    out[1] = w2 * f[0] - w0 * f[2]
+    out[2] = w0 * f[1] - w1 * f[0]
+    out[3] = w1 * f[5] - w2 * f[4] + v1 * f[2] - v2 * f[1]
+    out[4] = w2 * f[3] - w0 * f[5] + v2 * f[0] - v0 * f[2]
+    out[5] = w0 * f[4] - w1 * f[3] + v0 * f[1] - v1 * f[0]
+
+
+@njit(**_JIT)
+def inertia_mul(theta, m, out):
+    """Momentum of a motion: ``out = I m`` with ``I`` given by its 10 parameters.
+
+    ``[f; n] = [mass v - h x w; I_o w + h x v]``.
+    """
+    mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
+    ixx, ixy, iyy, ixz, iyz, izz = theta[4], theta[5], theta[6], theta[7], theta[8], theta[9]
+    v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
+    out[0] = mass * v0 - (hy * w2 - hz * w1)
+    out[1] = mass * v1 - (hz * w0 - hx * w2)
+    out[2] = mass * v2 - (hx * w1 - hy * w0)
+    out[3] = ixx * w0 + ixy * w1 + ixz * w2 + (hy * v2 - hz * v1)
+    out[4] = ixy * w0 + iyy * w1 + iyz * w2 + (hz * v0 - hx * v2)
+    out[5] = ixz * w0 + iyz * w1 + izz * w2 + (hx * v1 - hy * v0)
+
+
+@njit(**_JIT)
+def inertia_act(R, p, theta, out):
+    """Inertial parameters of a body expressed in the parent frame of placement ``(R, p)``.
+
+    ``h' = R h + m p``;
+    ``I' = R I R^T - p h_r^T - h_r p^T + 2 (p . h_r) 1 - m p p^T + m |p|^2 1`` with
+    ``h_r = R h`` (parallel-axis theorem without dividing by the mass).
+    """
+    mass = theta[0]
+    hr0 = R[0, 0] * theta[1] + R[0, 1] * theta[2] + R[0, 2] * theta[3]
+    hr1 = R[1, 0] * theta[1] + R[1, 1] * theta[2] + R[1, 2] * theta[3]
+    hr2 = R[2, 0] * theta[1] + R[2, 1] * theta[2] + R[2, 2] * theta[3]
+    ixx, ixy, iyy, ixz, iyz, izz = theta[4], theta[5], theta[6], theta[7], theta[8], theta[9]
+    # A = I R^T, then J = R A
+    a00 = ixx * R[0, 0] + ixy * R[0, 1] + ixz * R[0, 2]
+    a01 = ixx * R[1, 0] + ixy * R[1, 1] + ixz * R[1, 2]
+    a02 = ixx * R[2, 0] + ixy * R[2, 1] + ixz * R[2, 2]
+    a10 = ixy * R[0, 0] + iyy * R[0, 1] + iyz * R[0, 2]
+    a11 = ixy * R[1, 0] + iyy * R[1, 1] + iyz * R[1, 2]
+    a12 = ixy * R[2, 0] + iyy * R[2, 1] + iyz * R[2, 2]
+    a20 = ixz * R[0, 0] + iyz * R[0, 1] + izz * R[0, 2]
+    a21 = ixz * R[1, 0] + iyz * R[1, 1] + izz * R[1, 2]
+    a22 = ixz * R[2, 0] + iyz * R[2, 1] + izz * R[2, 2]
+    j00 = R[0, 0] * a00 + R[0, 1] * a10 + R[0, 2] * a20
+    j01 = R[0, 0] * a01 + R[0, 1] * a11 + R[0, 2] * a21
+    j02 = R[0, 0] * a02 + R[0, 1] * a12 + R[0, 2] * a22
+    j11 = R[1, 0] * a01 + R[1, 1] * a11 + R[1, 2] * a21
+    j12 = R[1, 0] * a02 + R[1, 1] * a12 + R[1, 2] * a22
+    j22 = R[2, 0] * a02 + R[2, 1] * a12 + R[2, 2] * a22
+    p0, p1, p2 = p[0], p[1], p[2]
+    ph = p0 * hr0 + p1 * hr1 + p2 * hr2
+    pp = p0 * p0 + p1 * p1 + p2 * p2
+    out[0] = mass
+    out[1] = hr0 + mass * p0
+    out[2] = hr1 + mass * p1
+    out[3] = hr2 + mass * p2
+    out[4] = j00 - 2.0 * p0 * hr0 + 2.0 * ph - mass * p0 * p0 + mass * pp
+    out[5] = j01 - p0 * hr1 - hr0 * p1 - mass * p0 * p1
+    out[6] = j11 - 2.0 * p1 * hr1 + 2.0 * ph - mass * p1 * p1 + mass * pp
+    out[7] = j02 - p0 * hr2 - hr0 * p2 - mass * p0 * p2
+    out[8] = j12 - p1 * hr2 - hr1 * p2 - mass * p1 * p2
+    out[9] = j22 - 2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
+
+
+@njit(**_JIT)
+def inertia_matrix(theta, out):
+    """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters."""
+    mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
+    for r in range(6):
+        for c in range(6):
+            out[r, c] = 0.0
+    out[0, 0] = mass
+    out[1, 1] = mass
+    out[2, 2] = mass
+    # upper-right block: -[h]x ; lower-left: [h]x
+    out[0, 4] = hz
+    out[0, 5] = -hy
+    out[1, 3] = -hz
+    out[1, 5] = hx
+    out[2, 3] = hy
+    out[2, 4] = -hx
+    out[4, 0] = hz
+    out[5, 0] = -hy
+    out[3, 1] = -hz
+    out[5, 1] = hx
+    out[3, 2] = hy
+    out[4, 2] = -hx
+    out[3, 3] = theta[4]
+    out[3, 4] = theta[5]
+    out[4, 3] = theta[5]
+    out[4, 4] = theta[6]
+    out[3, 5] = theta[7]
+    out[5, 3] = theta[7]
+    out[4, 5] = theta[8]
+    out[5, 4] = theta[8]
+    out[5, 5] = theta[9]
+
+
+@njit(**_JIT)
+def dot6(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
+
+
+@njit(**_JIT)
+def matvec6(A, x, out):
+    for r in range(6):
+        s = 0.0
+        for c in range(6):
+            s += A[r, c] * x[c]
+        out[r] = s
+
+
+@njit(**_JIT)
+def matTvec6(A, x, out):
+    for r in range(6):
+        s = 0.0
+        for c in range(6):
+            s += A[c, r] * x[c]
+        out[r] = s
+
+
+@njit(**_JIT)
+def motion_transform_matrix_inv(R, p, X):
+    """6 x 6 matrix of ``motion_act_inv`` (parent to child coordinates)."""
+    for r in range(3):
+        for c in range(3):
+            X[r, c] = R[c, r]
+            X[r + 3, c + 3] = R[c, r]
+            X[r + 3, c] = 0.0
+    # -R^T [p]x
+    for r in range(3):
+        X[r, 3] = -(R[1, r] * (-p[2]) + R[2, r] * p[1])
+        X[r, 4] = -(R[0, r] * p[2] + R[2, r] * (-p[0]))
+        X[r, 5] = -(R[0, r] * (-p[1]) + R[1, r] * p[0])
+
+
+@njit(**_JIT)
+def congruence_to_parent(R, p, A, X, tmp, out):
+    """``out += X^T A X`` with ``X`` the parent-to-child motion transform of ``(R, p)``.
+
+    Expresses a child-frame articulated inertia ``A`` (6 x 6) in the parent frame and adds it.
+    ``X`` and ``tmp`` are 6 x 6 workspaces.
+    """
+    motion_transform_matrix_inv(R, p, X)
+    for r in range(6):
+        for c in range(6):
+            s = 0.0
+            for k in range(6):
+                s += A[r, k] * X[k, c]
+            tmp[r, c] = s
+    for r in range(6):
+        for c in range(6):
+            s = 0.0
+            for k in range(6):
+                s += X[k, r] * tmp[k, c]
+            out[r, c] += s
+
+
+@njit(**_JIT)
+def motion_cross_matrix(m, out):
+    """6 x 6 matrix of ``n -> m x n``."""
+    for r in range(6):
+        for c in range(6):
+            out[r, c] = 0.0
+    v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
+    # [w]x on both diagonal blocks, [v]x in the upper-right block
+    for o in (0, 3):
+        out[o + 0, o + 1] = -w2
+        out[o + 0, o + 2] = w1
+        out[o + 1, o + 0] = w2
+        out[o + 1, o + 2] = -w0
+        out[o + 2, o + 0] = -w1
+        out[o + 2, o + 1] = w0
+    out[0, 4] = -v2
+    out[0, 5] = v1
+    out[1, 3] = v2
+    out[1, 5] = -v0
+    out[2, 3] = -v1
+    out[2, 4] = v0
