@@ -59,3 +59,15 @@ def joint_transform(jtype, axis, q, iq, R, p):
         p[0] = q[iq]
         p[1] = q[iq + 1]
         p[2] = q[iq + 2]
+
+
+@njit(cache=True, inline="always")
+def friction_torque(dof, eps, v, k):
+    """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
+
+    ``dof[k] = [armature, b (viscous), Fc (Coulomb)]``; ``sgn`` is ``sign`` when ``eps == 0``
+    and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
+    """
+    vk = v[k]
+    s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
+    return dof[k, 1] * vk + dof[k, 2] * s

@@ -292,11 +292,11 @@ def motion_transform_matrix_inv(R, p, X):
             X[r, c] = R[c, r]
             X[r + 3, c + 3] = R[c, r]
             X[r + 3, c] = 0.0
-    # -R^T [p]x
+    # upper-right block -R^T [p]x, with the columns of [p]x: (0, p2, -p1), (-p2, 0, p0), (p1, -p0, 0)
     for r in range(3):
-        X[r, 3] = -(R[1, r] * (-p[2]) + R[2, r] * p[1])
-        X[r, 4] = -(R[0, r] * p[2] + R[2, r] * (-p[0]))
-        X[r, 5] = -(R[0, r] * (-p[1]) + R[1, r] * p[0])
+        X[r, 3] = -(R[1, r] * p[2] - R[2, r] * p[1])
+        X[r, 4] = -(R[2, r] * p[0] - R[0, r] * p[2])
+        X[r, 5] = -(R[0, r] * p[1] - R[1, r] * p[0])
 
 
 @njit(**_JIT)
@@ -342,3 +342,21 @@ def motion_cross_matrix(m, out):
     out[1, 5] = -v0
     out[2, 3] = -v1
     out[2, 4] = v0
+
+
+@njit(**_JIT)
+def wrench_to_local(frame, R, p, f, out):
+    """A wrench ``[force; torque]`` given in ``frame`` expressed in the body frame ``(R, p)``.
+
+    ``frame`` 0: already local; 1: world axes, torque about the world origin;
+    2: world axes, torque about the body origin.
+    """
+    if frame == 0:
+        for k in range(6):
+            out[k] = f[k]
+    elif frame == 1:
+        force_act_inv(R, p, f, out)
+    else:
+        for r in range(3):
+            out[r] = R[0, r] * f[0] + R[1, r] * f[1] + R[2, r] * f[2]
+            out[r + 3] = R[0, r] * f[3] + R[1, r] * f[4] + R[2, r] * f[5]

@@ -1,0 +1,235 @@
+"""Forward dynamics by the Articulated-Body Algorithm (RBDA Table 7.1), O(n).
+
+    a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)
+
+Pass 1 (root to leaves): ``v_i = iX_p v_p + S_i qd_i``, ``c_i = v_i x S_i qd_i``,
+``IA_i = I_i``, ``pA_i = v_i x* I_i v_i - f_ext_i``.
+
+Pass 2 (leaves to root): ``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``,
+``u_i = tau_i - S_i^T pA_i (- friction)``; the articulated inertia
+``Ia = IA_i - U_i D_i^-1 U_i^T`` and bias ``pa = pA_i + Ia c_i + U_i D_i^-1 u_i`` are added to
+the parent: ``IA_p += iX_p^T Ia iX_p``, ``pA_p += iX_p^T pa``.
+
+Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = iX_p a_p + c_i``,
+``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + S_i qdd_i``.
+
+A body whose ``D_i`` is singular (a massless leaf, a point mass on its joint axis) makes the
+forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..joints import friction_torque
+from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
+                       matvec6, motion_act_inv, motion_cross, wrench_to_local)
+from . import _inputs
+from .kinematics import placements, world_placements
+
+# D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
+SINGULAR_RTOL = 1e-12
+
+
+@njit(cache=True)
+def workspace(nb, nv):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6, 6)), np.empty((nb, 6)),
+            np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)), np.empty(nv), np.empty((3, 3)),
+            np.empty(3), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12)),
+            np.empty(6), np.empty(6), np.empty((6, 6)))
+
+
+@njit(cache=True, inline="always")
+def invert_block(Dinv, iv, n, G, tol):
+    """Invert the n x n block ``Dinv[iv:iv+n, :n]`` in place (Gauss-Jordan, partial pivoting).
+
+    Returns False when a pivot is not above ``tol``.
+    """
+    for r in range(n):
+        for c in range(n):
+            G[r, c] = Dinv[iv + r, c]
+            G[r, n + c] = 1.0 if r == c else 0.0
+    for col in range(n):
+        piv, best = col, abs(G[col, col])
+        for r in range(col + 1, n):
+            if abs(G[r, col]) > best:
+                piv, best = r, abs(G[r, col])
+        if not best > tol:
+            return False
+        if piv != col:
+            for c in range(2 * n):
+                G[col, c], G[piv, c] = G[piv, c], G[col, c]
+        inv = 1.0 / G[col, col]
+        for c in range(2 * n):
+            G[col, c] *= inv
+        for r in range(n):
+            if r != col:
+                fac = G[r, col]
+                if fac != 0.0:
+                    for c in range(2 * n):
+                        G[r, c] -= fac * G[col, c]
+    for r in range(n):
+        for c in range(n):
+            Dinv[iv + r, c] = G[r, n + c]
+    return True
+
+
+@njit(cache=True)
+def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
+    """Forward dynamics of one state into ``qdd`` (nv,). Returns 0, or ``i + 1`` when the
+    articulated inertia of body ``i`` is singular."""
+    (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
+     X, tmp, UD, G, t1, t2, Ia) = ws
+    nb = ints.shape[0]
+    placements(ints, body, q, liR, lip, Rj, pj)
+    if fcode > 0:
+        world_placements(ints, liR, lip, oR, op)
+    # Pass 1
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+        else:
+            vel[i, :] = 0.0
+        t1[:] = 0.0
+        for k in range(iv, iv + n):
+            for r in range(6):
+                t1[r] += S[k, r] * v[k]
+        for r in range(6):
+            vel[i, r] += t1[r]
+        motion_cross(vel[i], t1, c[i])
+        theta = body[i, 15:25]
+        inertia_matrix(theta, IA[i])
+        inertia_mul(theta, vel[i], t1)
+        force_cross(vel[i], t1, pA[i])
+        if fcode >= 0:
+            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
+            for r in range(6):
+                pA[i, r] -= t1[r]
+    # Pass 2
+    for i in range(nb - 1, -1, -1):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        scale = 0.0
+        for r in range(6):
+            scale += abs(IA[i, r, r])
+        for k in range(iv, iv + n):
+            matvec6(IA[i], S[k], U[k])
+            s = 0.0
+            for r in range(6):
+                s += S[k, r] * pA[i, r]
+            u[k] = tau[k] - s - friction_torque(dof, eps, v, k)
+            for j in range(iv, iv + n):
+                d = 0.0
+                for r in range(6):
+                    d += S[j, r] * U[k, r]
+                Dinv[j, k - iv] = d + (dof[k, 0] if j == k else 0.0)
+        if not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+            return i + 1
+        if par >= 0:
+            # UD = U Dinv (6 x n), Ia = IA - UD U^T, pa = pA + Ia c + UD u
+            for r in range(6):
+                for j in range(n):
+                    s = 0.0
+                    for k in range(n):
+                        s += U[iv + k, r] * Dinv[iv + k, j]
+                    UD[r, j] = s
+            for r in range(6):
+                for cc in range(6):
+                    s = IA[i, r, cc]
+                    for j in range(n):
+                        s -= UD[r, j] * U[iv + j, cc]
+                    Ia[r, cc] = s
+            matvec6(Ia, c[i], t1)
+            for r in range(6):
+                s = pA[i, r] + t1[r]
+                for j in range(n):
+                    s += UD[r, j] * u[iv + j]
+                t2[r] = s
+            congruence_to_parent(liR[i], lip[i], Ia, X, tmp, IA[par])
+            force_act(liR[i], lip[i], t2, t1)
+            for r in range(6):
+                pA[par, r] += t1[r]
+    # Pass 3
+    for k in range(6):
+        t2[k] = 0.0
+    t2[0], t2[1], t2[2] = -grav[0], -grav[1], -grav[2]
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], acc[par], acc[i])
+        else:
+            motion_act_inv(liR[i], lip[i], t2, acc[i])
+        for r in range(6):
+            acc[i, r] += c[i, r]
+        for k in range(iv, iv + n):
+            s = 0.0
+            for r in range(6):
+                s += U[k, r] * acc[i, r]
+            t1[k - iv] = u[k] - s
+        for j in range(iv, iv + n):
+            s = 0.0
+            for k in range(n):
+                s += Dinv[j, k] * t1[k]
+            qdd[j] = s
+        for k in range(iv, iv + n):
+            for r in range(6):
+                acc[i, r] += S[k, r] * qdd[k]
+    return 0
+
+
+@njit(cache=True, parallel=True)
+def _aba_batch(ints, body, S, dof, grav, eps, Q, V, T, F, fcode, QDD, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], S.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = aba_one(ints, body, S, dof, grav, eps, Q[s], V[s], T[s], F[s if F.shape[0] > 1 else 0],
+                                fcode, QDD[s], ws)
+
+
+@njit(cache=True)
+def _aba_single(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd):
+    return aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, workspace(ints.shape[0], S.shape[0]))
+
+
+def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
+        armature: bool = True, check_finite: bool = True) -> np.ndarray:
+    """Forward dynamics: the acceleration produced by joint forces ``tau`` at ``(q, v)``.
+
+    ``a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)``
+
+    Args:
+        q: (..., nq). v, tau: (..., nv). f_ext, f_ext_frame, friction, armature,
+        check_finite: as in :func:`robodyn.rnea`.
+
+    Returns:
+        a: (..., nv), the inverse of :func:`robodyn.rnea`: ``aba(q, v, rnea(q, v, a)) == a``.
+
+    Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
+    leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
+    """
+    batch, flat = _inputs.states(model, check_finite, q=q, v=v, tau=tau)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    ints, body, S, _ = model._kernel
+    dof = model._dof(friction, armature)
+    Q, V, T = flat["q"], flat["v"], flat["tau"]
+    B = Q.shape[0]
+    QDD = np.empty((B, model.nv))
+    eps = model.coulomb_smoothing
+    nchunk = _inputs.chunks(B)
+    if nchunk:
+        status = np.zeros(B, dtype=np.int64)
+        _aba_batch(ints, body, S, dof, model.gravity, eps, Q, V, T, F, fcode, QDD, status, nchunk)
+        bad = int(status.max())
+    else:
+        bad = _aba_single(ints, body, S, dof, model.gravity, eps, Q[0], V[0], T[0], F[0], fcode, QDD[0])
+    if bad:
+        i = bad - 1
+        raise ValueError(
+            f"aba: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
+            f"{model.body_joint_names[i]!r}) is singular, so the forward dynamics is undefined; "
+            "give the bodies beyond it mass and inertia about the joint axis (or armature)"
+        )
+    return _inputs.unflatten(QDD, batch)

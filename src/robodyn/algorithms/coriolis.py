@@ -1,0 +1,158 @@
+"""Coriolis matrix ``C(q, v)`` with ``Mdot - 2C`` skew-symmetric, O(n d) (d: tree depth).
+
+With world-frame Jacobians ``J_i`` and inertias ``I_i`` (Echeandia and Wensing, "Numerical
+methods to compute the Coriolis matrix and Christoffel symbols for rigid-body systems",
+J. Comput. Nonlinear Dynam. 2021)::
+
+    C = sum_i J_i^T (I_i Jdot_i + B_i J_i),
+    B_i = 1/2 [ (V_i x*) I_i - I_i (V_i x) + (I_i V_i) xbar ],    (f xbar) m = m x* f
+
+so that ``C v`` is the Coriolis/centrifugal vector (``B_i V_i = V_i x* I_i V_i``) and
+``Mdot - 2C = Jdot^T I J - J^T I Jdot`` is skew-symmetric. Accumulating composite ``I^c`` and
+``B^c`` from the leaves, for a dof ``k`` of body ``i`` (``Sdot_k = V_i x oS_k``) and a dof ``l``
+of ``i`` or of an ancestor::
+
+    C[l, k] = oS_l . (I^c_i Sdot_k + B^c_i oS_k)
+    C[k, l] = Sdot_l . (I^c_i oS_k) + oS_l . (B^c_i^T oS_k)     (l on a strict ancestor)
+
+``C`` is linear in ``v`` and equals ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel symbols
+of the first kind ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..spatial import dot6, inertia_matrix, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
+from . import _inputs
+from .crba import world_inertias
+from .kinematics import placements, world_motion_subspace, world_placements
+
+
+@njit(cache=True)
+def workspace(nb, nv):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nv, 6)), np.empty((nb, 10)),
+            np.empty((nb, 6, 6)), np.empty((nb, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty(6),
+            np.empty(6), np.empty(6), np.empty(6))
+
+
+@njit(cache=True, inline="always")
+def body_B(theta, V, Imat, Vx, h, B):
+    """``B = 1/2 [ (V x*) I - I (V x) + (I V) xbar ]`` (6 x 6) of one body."""
+    inertia_matrix(theta, Imat)
+    motion_cross_matrix(V, Vx)
+    matvec6(Imat, V, h)
+    for r in range(6):
+        for c in range(6):
+            s = 0.0
+            for k in range(6):
+                s += -Vx[k, r] * Imat[k, c] - Imat[r, k] * Vx[k, c]
+            B[r, c] = 0.5 * s
+    # (h xbar) = [[0, -[f]x], [-[f]x, -[n]x]] with h = [f; n]
+    f0, f1, f2, n0, n1, n2 = h[0], h[1], h[2], h[3], h[4], h[5]
+    for o_r, o_c, a0, a1, a2 in ((0, 3, f0, f1, f2), (3, 0, f0, f1, f2), (3, 3, n0, n1, n2)):
+        B[o_r + 0, o_c + 1] += 0.5 * a2
+        B[o_r + 0, o_c + 2] -= 0.5 * a1
+        B[o_r + 1, o_c + 0] -= 0.5 * a2
+        B[o_r + 1, o_c + 2] += 0.5 * a0
+        B[o_r + 2, o_c + 0] += 0.5 * a1
+        B[o_r + 2, o_c + 1] -= 0.5 * a0
+
+
+@njit(cache=True)
+def coriolis_one(ints, body, S, q, v, C, ws):
+    liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, Imat, Vx, F1, F2, F3, h = ws
+    nb = ints.shape[0]
+    placements(ints, body, q, liR, lip, Rj, pj)
+    world_placements(ints, liR, lip, oR, op)
+    world_motion_subspace(ints, S, oR, op, oS)
+    world_inertias(ints, body, oR, op, Ic)
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        for r in range(6):
+            oV[i, r] = oV[par, r] if par >= 0 else 0.0
+        for k in range(iv, iv + n):
+            for r in range(6):
+                oV[i, r] += oS[k, r] * v[k]
+        for k in range(iv, iv + n):
+            motion_cross(oV[i], oS[k], oSd[k])
+        body_B(Ic[i], oV[i], Imat, Vx, h, Bc[i])
+    C[:, :] = 0.0
+    for i in range(nb - 1, -1, -1):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        for k in range(iv, iv + n):
+            inertia_mul(Ic[i], oSd[k], F1)
+            matvec6(Bc[i], oS[k], F2)
+            for r in range(6):
+                F1[r] += F2[r]
+            inertia_mul(Ic[i], oS[k], F2)
+            matTvec6(Bc[i], oS[k], F3)
+            for l in range(iv, iv + n):
+                C[l, k] = dot6(oS[l], F1)
+            j = par
+            while j >= 0:
+                for l in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+                    C[l, k] = dot6(oS[l], F1)
+                    C[k, l] = dot6(oSd[l], F2) + dot6(oS[l], F3)
+                j = ints[j, 0]
+        if par >= 0:
+            for r in range(10):
+                Ic[par, r] += Ic[i, r]
+            for r in range(6):
+                for c in range(6):
+                    Bc[par, r, c] += Bc[i, r, c]
+
+
+@njit(cache=True, parallel=True)
+def _coriolis_batch(ints, body, S, Q, V, CC, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], S.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            coriolis_one(ints, body, S, Q[s], V[s], CC[s], ws)
+
+
+@njit(cache=True)
+def _coriolis_single(ints, body, S, q, v, C):
+    coriolis_one(ints, body, S, q, v, C, workspace(ints.shape[0], S.shape[0]))
+
+
+def _run(model, Q, V):
+    ints, body, S, _ = model._kernel
+    B = Q.shape[0]
+    CC = np.empty((B, model.nv, model.nv))
+    nchunk = _inputs.chunks(B)
+    if nchunk:
+        _coriolis_batch(ints, body, S, Q, V, CC, nchunk)
+    else:
+        _coriolis_single(ints, body, S, Q[0], V[0], CC[0])
+    return CC
+
+
+def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
+    """Coriolis matrix ``C(q, v)``: (..., nv, nv) for q (..., nq), v (..., nv).
+
+    ``C v`` is the Coriolis/centrifugal vector ``nonlinear_effects(q, v) - gravity(q)``,
+    ``Mdot - 2C`` is skew-symmetric and ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel
+    symbols of :func:`christoffel_symbols`. Reference: Echeandia and Wensing (2021).
+    """
+    batch, flat = _inputs.states(model, check_finite, q=q, v=v)
+    return _inputs.unflatten(_run(model, flat["q"], flat["v"]), batch)
+
+
+def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
+    """Christoffel symbols of the first kind, ``Gamma[..., i, j, k]`` (..., nv, nv, nv).
+
+    ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2`` (for a floating base, the
+    derivatives along the base's local-frame velocity directions), symmetric in ``j, k``;
+    ``coriolis_matrix(q, v)[i, j] == sum_k Gamma[i, j, k] v[k]``. Since ``C`` is linear in
+    ``v``, ``Gamma[..., :, :, k] = C(q, e_k)``.
+    """
+    batch, flat = _inputs.states(model, check_finite, q=q)
+    nv = model.nv
+    Q = np.repeat(flat["q"], nv, axis=0)
+    V = np.tile(np.eye(nv), (flat["q"].shape[0], 1))
+    CC = _run(model, Q, V).reshape(-1, nv, nv, nv)  # (B, k, i, j)
+    return _inputs.unflatten(np.ascontiguousarray(CC.transpose(0, 2, 3, 1)), batch)

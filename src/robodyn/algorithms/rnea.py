@@ -1,0 +1,144 @@
+"""Inverse dynamics by the Recursive Newton-Euler Algorithm (RBDA Table 5.1), O(n).
+
+    tau = M(q) a + C(q, v) v + g(q) - sum_i J_i(q)^T f_ext_i  [+ armature a + friction(v)]
+
+Pass 1 (root to leaves), in body coordinates, with gravity as a fictitious base acceleration
+``a_0 = -g``::
+
+    v_i = iX_p v_p + S_i qd_i
+    a_i = iX_p a_p + S_i qdd_i + v_i x S_i qd_i
+    f_i = I_i a_i + v_i x* I_i v_i - f_ext_i
+
+Pass 2 (leaves to root)::
+
+    tau_i = S_i^T f_i (+ armature, friction),   f_p += iX_p^T f_i
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..joints import friction_torque
+from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
+from . import _inputs
+from .kinematics import placements, world_placements
+
+
+@njit(cache=True)
+def workspace(nb):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty((3, 3)), np.empty(3),
+            np.empty(6), np.empty(6), np.empty(6))
+
+
+@njit(cache=True)
+def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
+    """Inverse dynamics of one state into ``tau`` (nv,). ``fcode < 0``: no external wrench."""
+    liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
+    nb = ints.shape[0]
+    placements(ints, body, q, liR, lip, Rj, pj)
+    if fcode > 0:
+        world_placements(ints, liR, lip, oR, op)
+    for k in range(6):
+        t2[k] = 0.0
+    t2[0], t2[1], t2[2] = -grav[0], -grav[1], -grav[2]
+    # Pass 1: velocities, accelerations and body forces
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+            motion_act_inv(liR[i], lip[i], acc[par], acc[i])
+        else:
+            vel[i, :] = 0.0
+            motion_act_inv(liR[i], lip[i], t2, acc[i])
+        vJ[:] = 0.0
+        for k in range(iv, iv + n):
+            for r in range(6):
+                vJ[r] += S[k, r] * v[k]
+                acc[i, r] += S[k, r] * a[k]
+        for r in range(6):
+            vel[i, r] += vJ[r]
+        motion_cross(vel[i], vJ, t1)
+        for r in range(6):
+            acc[i, r] += t1[r]
+        theta = body[i, 15:25]
+        inertia_mul(theta, acc[i], f[i])
+        inertia_mul(theta, vel[i], t1)
+        force_cross(vel[i], t1, vJ)
+        for r in range(6):
+            f[i, r] += vJ[r]
+        if fcode >= 0:
+            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
+            for r in range(6):
+                f[i, r] -= t1[r]
+    # Pass 2: joint torques and forces transmitted to the parents
+    for i in range(nb - 1, -1, -1):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        for k in range(iv, iv + n):
+            s = 0.0
+            for r in range(6):
+                s += S[k, r] * f[i, r]
+            tau[k] = s + dof[k, 0] * a[k] + friction_torque(dof, eps, v, k)
+        if par >= 0:
+            force_act(liR[i], lip[i], f[i], t1)
+            for r in range(6):
+                f[par, r] += t1[r]
+
+
+@njit(cache=True, parallel=True)
+def _rnea_batch(ints, body, S, dof, grav, eps, Q, V, A, F, fcode, TAU, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            rnea_one(ints, body, S, dof, grav, eps, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0], fcode, TAU[s], ws)
+
+
+@njit(cache=True)
+def _rnea_single(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau):
+    rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, workspace(ints.shape[0]))
+
+
+def run(model, Q, V, A, F, fcode, gravity, dof) -> np.ndarray:
+    """RNEA on flat batches (B, n); the other algorithms build on this entry point."""
+    ints, body, S, _ = model._kernel
+    B = Q.shape[0]
+    TAU = np.empty((B, model.nv))
+    nchunk = _inputs.chunks(B)
+    eps = model.coulomb_smoothing
+    if nchunk:
+        _rnea_batch(ints, body, S, dof, gravity, eps, Q, V, A, F, fcode, TAU, nchunk)
+    else:
+        _rnea_single(ints, body, S, dof, gravity, eps, Q[0], V[0], A[0], F[0], fcode, TAU[0])
+    return TAU
+
+
+def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
+         armature: bool = True, check_finite: bool = True) -> np.ndarray:
+    """Inverse dynamics: the joint forces that produce acceleration ``a`` at state ``(q, v)``.
+
+    ``tau = M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i + armature * a + friction(v)``
+
+    Args:
+        q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
+        f_ext: optional (..., nbodies, 6) external wrenches ``[force, torque]`` applied to each
+            body, expressed in ``f_ext_frame``: ``"local"`` (body frame, torque about the body
+            origin), ``"world"`` (world axes, torque about the world origin) or
+            ``"local_world_aligned"`` (world axes, torque about the body origin).
+        friction: add the model's joint friction ``damping v + coulomb sgn(v)``.
+        armature: add the model's reflected rotor inertia ``armature * a``.
+        check_finite: reject NaN/Inf inputs (turn off only in hot loops with trusted input).
+
+    Returns:
+        tau: (..., nv). For a floating base its first six entries are the base wrench
+        ``[force, torque]`` in the base frame.
+
+    Equivalences: ``rnea(q, 0, 0) == gravity(q)``, ``rnea(q, v, 0, friction=False) ==
+    nonlinear_effects(q, v)``, ``rnea(q, v, a) == crba(q) a + nonlinear_effects(q, v)`` without
+    friction. Reference: Featherstone, RBDA (2008), Table 5.1.
+    """
+    batch, flat = _inputs.states(model, check_finite, q=q, v=v, a=a)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    TAU = run(model, flat["q"], flat["v"], flat["a"], F, fcode, model.gravity, model._dof(friction, armature))
+    return _inputs.unflatten(TAU, batch)
