@@ -171,19 +171,29 @@ class ModelBuilder:
             children[jt.parent].append(jt)
         roots = [name for name in self._links if name not in parent_joint]
         if len(roots) > 1:
-            raise ModelError(f"{self.source}: several root links {roots}; a robot is one tree")
-        if not roots:
-            raise ModelError(f"{self.source}: no root link: the joints form a cycle")
+            shown = "; ".join(self._links[r].where for r in roots[:5]) + ("; ..." if len(roots) > 5 else "")
+            raise ModelError(f"{self.source}: several root links {roots[:5]} ({shown}); a robot is one tree")
         # every link has at most one parent, so links unreachable from the root lie on cycles
-        reached, stack = {roots[0]}, [roots[0]]
+        reached, stack = set(roots), list(roots)
         while stack:
             for jt in children[stack.pop()]:
                 reached.add(jt.child)
                 stack.append(jt.child)
         if len(reached) != len(self._links):
-            cyc = sorted(set(self._links) - reached)
-            raise ModelError(f"{self.source}: the joints form a cycle through links {cyc}")
+            raise ModelError(self._cycle_message(next(n for n in self._links if n not in reached), parent_joint))
         return roots[0], children
+
+    def _cycle_message(self, link: str, parent_joint: dict[str, _Joint]) -> str:
+        """Name the joints of the cycle upstream of ``link`` (which is not reachable from a root)."""
+        path, seen = [], {}
+        while link not in seen:  # walk parents; every link on the way has exactly one
+            seen[link] = len(path)
+            path.append(parent_joint[link])
+            link = path[-1].parent
+        cycle = path[seen[link]:][::-1]
+        shown = "; ".join(jt.where for jt in cycle[:5]) + ("; ..." if len(cycle) > 5 else "")
+        links = [jt.child for jt in cycle]
+        return f"{self.source}: the joints form a cycle through links {links[:5]}{' ...' if len(links) > 5 else ''} ({shown})"
 
     def build(self, floating_base: bool = False) -> Model:
         """The :class:`Model`; a floating base adds a free joint ``root_joint`` at the root."""
