@@ -34,9 +34,11 @@ INERTIA_ATOL = 1e-12
 
 
 def _readonly(a, dtype=float):
+    """A read-only copy; returned as a view of a read-only base so that setting
+    ``flags.writeable = True`` on it fails as well."""
     a = np.array(a, dtype=dtype, copy=True)
     a.flags.writeable = False
-    return a
+    return a.view()
 
 
 def inertial_parameters_from(mass: float, com, inertia_com) -> np.ndarray:
@@ -262,6 +264,9 @@ class Model:
         setattr_(self, "_dof_variants", {})
 
     def __setattr__(self, key, value):
+        raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
+
+    def __delattr__(self, key):
         raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
 
     # -- derived quantities ------------------------------------------------------------
