@@ -2,10 +2,13 @@
 
 Reads links (``<inertial>`` with origin xyz/rpy applied as ``R I R^T``), and joints of type
 revolute, continuous, prismatic and fixed (merged into the parent body), with ``<origin>``,
-``<axis>`` (normalised; zero is an error), ``<limit>``, ``<dynamics damping friction>``.
-``<mimic>`` joints load as independent joints with a warning. Elements without dynamic
-content (visual, collision, material, gazebo, transmission, ...) are reported in one
-:class:`RobodynWarning` per file.
+``<axis>`` (normalised; zero is an error), ``<limit lower upper velocity effort>`` (lower and
+upper default to 0 as in the URDF specification; a joint without ``<limit>`` is unbounded,
+continuous joints always are), ``<dynamics damping friction>``.
+``<mimic>`` joints load as independent joints with a warning. Elements without rigid-body
+dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
+reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
+dynamics and is skipped without a warning.
 
 XML is parsed with DTDs, entities and external references forbidden (defusedxml). Every
 error is a :class:`~robodyn.model.ModelError` naming the file, the element and its line.
@@ -20,7 +23,7 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
-from defusedxml import DefusedXmlException
+from defusedxml import DefusedXmlException, DTDForbidden
 from defusedxml.ElementTree import DefusedXMLParser, ParseError
 
 from ..builder import ModelBuilder, rpy_to_matrix
@@ -42,7 +45,9 @@ class _LineParser(DefusedXMLParser):
     def _start(self, tag, attr_list):
         self._depth += 1
         if self._depth > MAX_DEPTH:
-            raise ModelError(f"line {self.parser.CurrentLineNumber}: elements nested deeper than {MAX_DEPTH} levels")
+            raise ModelError(
+                f"<{tag}> (line {self.parser.CurrentLineNumber}): elements nested deeper than {MAX_DEPTH} levels"
+            )
         elem = super()._start(tag, attr_list)
         self.lines[id(elem)] = self.parser.CurrentLineNumber
         return elem
@@ -54,16 +59,24 @@ class _LineParser(DefusedXMLParser):
 
 def _read_source(source) -> tuple[str, str]:
     """``(xml_text, name)`` from a path or an XML string."""
-    if isinstance(source, (str, os.PathLike)) and not (isinstance(source, str) and source.lstrip().startswith("<")):
+    if isinstance(source, str) and not source.strip():
+        raise ModelError("<string>: empty input: expected a URDF path or XML text")
+    if isinstance(source, (str, os.PathLike)) and not (isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")):
         path = Path(source)
         try:
-            size = path.stat().st_size
-        except OSError as e:
-            raise ModelError(f"{path}: cannot read URDF file ({e.strerror})") from None
+            is_file = path.is_file()
+            size = path.stat().st_size if is_file else 0
+        except (OSError, ValueError) as e:
+            raise ModelError(f"{path}: cannot read URDF file ({getattr(e, 'strerror', None) or e})") from None
+        if not is_file:
+            reason = "not a regular file" if path.exists() else "no such file"
+            raise ModelError(f"{path}: cannot read URDF file ({reason})")
         if size > MAX_FILE_BYTES:
             raise ModelError(f"{path}: file of {size} bytes exceeds the limit of {MAX_FILE_BYTES} bytes")
         try:
             return path.read_bytes().decode("utf-8"), str(path)
+        except OSError as e:
+            raise ModelError(f"{path}: cannot read URDF file ({e.strerror or e})") from None
         except UnicodeDecodeError as e:
             raise ModelError(f"{path}: not UTF-8 text ({e})") from None
     if isinstance(source, bytes):
@@ -75,6 +88,15 @@ def _read_source(source) -> tuple[str, str]:
     return source, "<string>"
 
 
+def _source_line(text: str, line) -> str:
+    """The stripped text of a 1-based line (shortened), to show where the XML breaks."""
+    lines = text.splitlines()
+    if not isinstance(line, int) or not 1 <= line <= len(lines):
+        return ""
+    snippet = lines[line - 1].strip()
+    return f": {snippet[:80] + ('...' if len(snippet) > 80 else '')!r}"
+
+
 def _parse(text: str, name: str):
     parser = _LineParser()
     try:
@@ -82,9 +104,17 @@ def _parse(text: str, name: str):
         root = parser.close()
     except ParseError as e:
         line = e.position[0] if getattr(e, "position", None) else "?"
-        raise ModelError(f"{name}: line {line}: malformed XML ({e})") from None
+        raise ModelError(f"{name}: line {line}{_source_line(text, line)}: malformed XML ({e})") from None
     except DefusedXmlException as e:
-        raise ModelError(f"{name}: forbidden XML construct ({type(e).__name__}: {e}); DTDs and entities are not allowed") from None
+        line = parser.parser.CurrentLineNumber
+        if isinstance(e, DTDForbidden):
+            what = f"<!DOCTYPE {e.name}>"
+        else:
+            what = f"<!ENTITY {e.name}>" if hasattr(e, "name") else "external reference"
+        raise ModelError(
+            f"{name}: {what} (line {line}): forbidden XML construct ({type(e).__name__}); "
+            "DTDs and entities are not allowed"
+        ) from None
     except ModelError as e:
         raise ModelError(f"{name}: {e}") from None
     except RecursionError:
@@ -161,10 +191,12 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
             joint_elems.append(elem)
         else:
             ignored[elem.tag] += 1
+    if root.find("link") is None:
+        raise ModelError(f"{rd.where(root)}: no <link> element")
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
         if elem.find("mimic") is not None:
             mimic.append(elem.get("name"))
-        _read_joint(rd, b, elem)
+        _read_joint(rd, b, elem, ignored)
     if mimic:
         warnings.warn(f"{name}: mimic joints loaded as independent joints: {mimic}", RobodynWarning, stacklevel=2)
     ignored_dyn = {k: v for k, v in ignored.items() if k not in _LINK_IGNORED}
@@ -203,8 +235,14 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     b.add_link(lname, mass=mass, com=xyz, inertia=I, inertia_rotation=rpy_to_matrix(rpy), where=where)
 
 
-def _read_joint(rd: _Reader, b: ModelBuilder, elem) -> None:
+_JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
+
+
+def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     where = rd.where(elem)
+    for child in elem:
+        if isinstance(child.tag, str) and child.tag not in _JOINT_READ:
+            ignored[child.tag] += 1
     jname = elem.get("name")
     jtype = elem.get("type")
     if not jname:
@@ -224,9 +262,13 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem) -> None:
     dyn = elem.find("dynamics")
     kw = {}
     if lim is not None:
-        for key, attr in (("lower", "lower"), ("upper", "upper"), ("velocity", "velocity"), ("effort", "effort")):
-            if lim.get(attr) is not None:
-                kw[key] = rd.floats(lim, attr, 1)[0]
+        # URDF: lower and upper default to 0 in a <limit> (urdfdom and Pinocchio read it so);
+        # without a <limit> element robodyn leaves the joint unbounded.
+        for key in ("lower", "upper"):
+            kw[key] = rd.floats(lim, key, 1, (0.0,))[0]
+        for key in ("velocity", "effort"):
+            if lim.get(key) is not None:
+                kw[key] = rd.floats(lim, key, 1)[0]
     if dyn is not None:
         for key in ("damping", "friction"):
             if dyn.get(key) is not None:
