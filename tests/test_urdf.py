@@ -1,0 +1,543 @@
+"""URDF loader: example-robot-data against Pinocchio, bad input, and URDF semantics by hand."""
+
+from __future__ import annotations
+
+import functools
+import warnings
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from scipy.spatial.transform import Rotation
+
+import robodyn as rd
+import robodyn.io.urdf as urdf_module
+from robodyn import joints
+from conftest import FIXTURES, assert_names_line, erd_id, example_robot_urdfs, marked_lines
+
+# ----------------------------------------------------------------------------------------
+# example-robot-data, compared with Pinocchio
+# ----------------------------------------------------------------------------------------
+
+# Published URDFs whose inertias no rigid body can have (not positive semi-definite, or
+# principal moments violating I1 + I2 >= I3, or zero mass with inertia). robodyn refuses
+# them by default, naming the first such link of the file (the one listed), and loads them
+# with physical="warn". Found by loading every file of the installed example-robot-data.
+UNPHYSICAL = {
+    "alex_description/urdf/alex_psyonic_hands.urdf": "LeftPsyonicAbilityBaseLink",
+    "allegro_hand_description/urdf/allegro_left_hand.urdf": "link_11.0",
+    "allegro_hand_description/urdf/allegro_right_hand.urdf": "link_3.0",
+    "anymal_b_simple_description/robots/anymal-kinova.urdf": "base",
+    "anymal_b_simple_description/robots/anymal.urdf": "base",
+    "anymal_c_simple_description/urdf/anymal.urdf": "depth_camera_front_camera",
+    "b1_description/urdf/b1-z1.urdf": "base",
+    "b1_description/urdf/b1.urdf": "base",
+    "bolt_description/robots/bolt.urdf": "FL_FOOT",
+    "go1_description/urdf/go1.urdf": "base",
+    "hyq_description/robots/hyq_no_sensors.urdf": "base_link",
+    "pr2_description/urdf/pr2.urdf": "sensor_mount_link",
+    "romeo_description/urdf/romeo_laas_small.urdf": "LShoulderYaw_link",
+    "romeo_description/urdf/romeo_small.urdf": "RShoulderYawLink",
+    "tiago_description/robots/tiago.urdf": "base_antenna_left_link",
+    "tiago_description/robots/tiago_dual.urdf": "base_antenna_left_link",
+    "tiago_description/robots/tiago_no_hand.urdf": "base_antenna_left_link",
+}
+
+# Files Pinocchio (urdfdom) refuses, with the reason; robodyn refuses them too.
+PINOCCHIO_REFUSES = {
+    "ur_description/urdf/ur3.urdf": "no <link> element",  # a <robot> holding only a comment
+}
+
+ALL_URDFS = example_robot_urdfs()
+PIN_URDFS = [p for p in ALL_URDFS if erd_id(p) not in PINOCCHIO_REFUSES]
+
+
+def test_example_robot_data_is_found():
+    assert len(ALL_URDFS) >= 60
+    known = {erd_id(p) for p in ALL_URDFS}
+    assert set(UNPHYSICAL) <= known and set(PINOCCHIO_REFUSES) <= known
+
+
+@functools.lru_cache(maxsize=None)
+def _pin_model(path: str, floating_base: bool) -> pin.Model:
+    if floating_base:
+        return pin.buildModelFromUrdf(path, pin.JointModelFreeFlyer())
+    return pin.buildModelFromUrdf(path)
+
+
+def _load_quietly(path, **kw) -> rd.Model:
+    """Load, ignoring the RobodynWarnings about <gazebo>, <transmission>, ... and unphysical
+    links (their presence is asserted in the tests that are about them)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        return rd.load_urdf(path, **kw)
+
+
+def _physical(path) -> str:
+    return "warn" if erd_id(path) in UNPHYSICAL else "error"
+
+
+def _theta_from_pinocchio(inertia: pin.Inertia) -> np.ndarray:
+    """10 parameters about the joint frame origin (DESIGN order) from Pinocchio's mass,
+    lever (centre of mass) and rotational inertia about the centre of mass."""
+    m, c, Ic = inertia.mass, np.asarray(inertia.lever), np.asarray(inertia.inertia)
+    Io = Ic + m * (c @ c * np.eye(3) - np.outer(c, c))  # parallel-axis theorem
+    return np.array([m, *(m * c), Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
+
+
+def _assert_close_groups(actual, expected, what):
+    """Mass, first moment and rotational inertia each to 1e-9 relative to their magnitude."""
+    for sl, name in ((slice(0, 1), "mass"), (slice(1, 4), "first moment"), (slice(4, 10), "inertia")):
+        scale = np.abs(expected[sl]).max()
+        np.testing.assert_allclose(actual[sl], expected[sl], rtol=1e-9, atol=1e-9 * scale + 1e-15,
+                                   err_msg=f"{what}: {name}")
+
+
+def _assert_matches_pinocchio(model: rd.Model, pm: pin.Model) -> None:
+    n_continuous = sum(1 for j in pm.joints[1:] if j.nv == 1 and j.nq == 2)  # cos, sin
+    assert model.nv == pm.nv
+    assert model.nq == pm.nq - n_continuous
+    assert list(model.body_joint_names) == list(pm.names[1:])
+    pm_mass = sum(pm.inertias[i].mass for i in range(1, pm.njoints))
+    assert model.total_mass == pytest.approx(pm_mass, rel=1e-12, abs=1e-300)
+    for j in range(1, pm.njoints):
+        i = model.body_joint_names.index(pm.names[j])
+        _assert_close_groups(model.inertia[i], _theta_from_pinocchio(pm.inertias[j]), f"body of {pm.names[j]}")
+        placement = pm.jointPlacements[j]
+        np.testing.assert_allclose(model.X_tree_R[i], placement.rotation, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(model.X_tree_p[i], placement.translation, rtol=0, atol=1e-12)
+        assert model.parent[i] < i
+
+
+@pytest.mark.parametrize("path", PIN_URDFS, ids=erd_id)
+def test_example_robot_data_matches_pinocchio(path):
+    pm = _pin_model(str(path), False)
+    model = _load_quietly(path, physical=_physical(path))
+    _assert_matches_pinocchio(model, pm)
+    assert list(model.joint_names) == list(pm.names[1:])
+    # Pinocchio's joint limits, velocity and effort limits, damping and friction
+    np.testing.assert_array_equal(model.damping, pm.damping)
+    np.testing.assert_array_equal(model.coulomb, pm.friction)
+    np.testing.assert_array_equal(model.velocity_limit, pm.velocityLimit)
+    np.testing.assert_array_equal(model.effort_limit, pm.effortLimit)
+    for j in range(1, pm.njoints):
+        if pm.joints[j].nq == 1:
+            k, iq = model.joint_names.index(pm.names[j]), pm.joints[j].idx_q
+            assert (model.lower[k], model.upper[k]) == (pm.lowerPositionLimit[iq], pm.upperPositionLimit[iq])
+
+
+@pytest.mark.parametrize("path", PIN_URDFS, ids=erd_id)
+def test_example_robot_data_floating_base_matches_pinocchio(path):
+    pm = _pin_model(str(path), True)
+    model = _load_quietly(path, floating_base=True, physical=_physical(path))
+    assert model.floating_base and model.body_joint_names[0] == "root_joint"
+    _assert_matches_pinocchio(model, pm)
+    assert list(model.joint_names) == list(pm.names[2:])
+
+
+@pytest.mark.parametrize("rel", sorted(UNPHYSICAL))
+def test_unphysical_example_robot_data_refused_then_loaded_with_warning(rel):
+    path = next(p for p in ALL_URDFS if erd_id(p) == rel)
+    link = UNPHYSICAL[rel]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        with pytest.raises(rd.ModelError) as err:
+            rd.load_urdf(path)
+    msg = str(err.value)
+    assert str(path) in msg and f"<link name={link!r}>" in msg and "line " in msg
+    assert "physical='warn'" in msg  # says how to load it anyway
+    with pytest.warns(rd.RobodynWarning) as record:
+        model = rd.load_urdf(path, physical="warn")
+    assert any(f"<link name={link!r}>" in str(w.message) and "kept as given" in str(w.message) for w in record)
+    assert model.physical == "warn"
+
+
+@pytest.mark.parametrize("rel", sorted(PINOCCHIO_REFUSES))
+def test_files_pinocchio_refuses_are_refused(rel):
+    path = next(p for p in ALL_URDFS if erd_id(p) == rel)
+    with pytest.raises(ValueError):
+        pin.buildModelFromUrdf(str(path))
+    with pytest.raises(rd.ModelError, match=PINOCCHIO_REFUSES[rel]) as err:
+        rd.load_urdf(path)
+    assert str(err.value).startswith(f"{path}: <robot> (line ")
+
+
+# ----------------------------------------------------------------------------------------
+# bad input: ModelError naming the file (or <string>), the element and the line
+# ----------------------------------------------------------------------------------------
+
+# (fixture file, element named in the message, what the message says); the lines marked
+# <!-- ERROR --> in the file must all be named.
+BAD_FILES = [
+    ("malformed.urdf", "</joint>", "malformed XML"),
+    ("unknown_joint_type.urdf", "<joint name='hinge'>", "unknown joint type 'ball'"),
+    ("link_without_name.urdf", "<link>", "link without a name"),
+    ("duplicate_link.urdf", "<link name='arm'>", "duplicate link name 'arm'"),
+    ("duplicate_joint.urdf", "<joint name='j1'>", "duplicate joint name 'j1'"),
+    ("missing_parent.urdf", "<joint name='j1'>", "parent link 'ghost' does not exist"),
+    ("missing_child.urdf", "<joint name='j2'>", "child link 'ghost' does not exist"),
+    ("several_roots.urdf", "<link name='island'>", "several root links"),
+    ("two_parents.urdf", "<joint name='j2'>", "link 'hand' has two parents"),
+    ("cycle.urdf", "<joint name='closing'>", "cycle"),
+    ("negative_mass.urdf", "<link name='arm'> <inertial>", "negative mass"),
+    ("zero_mass_with_inertia.urdf", "<link name='arm'> <inertial>", "zero mass"),
+    ("inertia_not_psd.urdf", "<link name='arm'> <inertial>", "not positive semi-definite"),
+    ("triangle_inequality.urdf", "<link name='arm'> <inertial>", "triangle inequality"),
+    ("zero_axis.urdf", "<joint name='j1'>", "joint axis is zero"),
+    ("limits_reversed.urdf", "<joint name='j1'>", "exceeds upper limit"),
+    ("wrong_number_count.urdf", "<origin>", "needs 3 number(s)"),
+    ("billion_laughs.urdf", "<!DOCTYPE lolz>", "forbidden"),
+    ("external_entity.urdf", "<!DOCTYPE robot>", "forbidden"),
+    ("dtd.urdf", "<!DOCTYPE robot>", "forbidden"),
+    ("too_deep.urdf", "<nest>", "nested deeper than 64 levels"),
+]
+
+
+@pytest.mark.parametrize("name, element, what", BAD_FILES, ids=[b[0] for b in BAD_FILES])
+def test_bad_file_names_file_element_and_line(fixture_path, monkeypatch, name, element, what):
+    monkeypatch.setattr(urdf_module, "MAX_DEPTH", 64)  # too_deep.urdf marks level 65
+    path = fixture_path(name)
+    text = path.read_text()
+    lines = marked_lines(text)
+    assert lines, f"{name} marks no line"
+    for source, label in ((path, str(path)), (str(path), str(path)), (text, "<string>")):
+        with pytest.raises(rd.ModelError) as err:
+            rd.load_urdf(source)
+        msg = str(err.value)
+        assert msg.startswith(label), msg
+        assert element in msg and what in msg, msg
+        for line in lines:
+            assert_names_line(msg, line)
+    assert isinstance(err.value, ValueError)
+
+
+_NONFINITE = """<robot name="nonfinite">
+  <link name="base"/>
+  <link name="arm">
+    <inertial>
+      <origin xyz="{inertial_xyz}" rpy="{inertial_rpy}"/>
+      <mass value="{mass}"/>
+      <inertia ixx="{ixx}" iyy="0.1" izz="0.1" ixy="{ixy}" ixz="0" iyz="0"/>
+    </inertial>
+  </link>
+  <joint name="j1" type="revolute">
+    <parent link="base"/>
+    <child link="arm"/>
+    <origin xyz="{xyz}" rpy="{rpy}"/>
+    <axis xyz="{axis}"/>
+    <limit lower="{lower}" upper="1" effort="{effort}" velocity="2"/>
+    <dynamics damping="{damping}" friction="0"/>
+  </joint>
+</robot>"""
+_GOOD = dict(inertial_xyz="0 0 0.1", inertial_rpy="0 0 0", mass="1", ixx="0.1", ixy="0", xyz="0 0 0.5",
+             rpy="0 0 0", axis="0 0 1", lower="-1", effort="10", damping="0.1")
+_ELEMENT = dict(inertial_xyz="<origin>", inertial_rpy="<origin>", mass="<mass>", ixx="<inertia>",
+                ixy="<inertia>", xyz="<origin>", rpy="<origin>", axis="<axis>", lower="<limit>",
+                effort="<limit>", damping="<dynamics>")
+
+
+def test_nonfinite_template_is_valid():
+    model = rd.load_urdf(_NONFINITE.format(**_GOOD))
+    assert model.nv == 1 and model.total_mass == 1.0
+
+
+@pytest.mark.parametrize("bad", ["nan", "NaN", "inf", "-inf", "1e999"])
+@pytest.mark.parametrize("field", sorted(_GOOD))
+def test_nonfinite_number_names_element_and_line(field, bad):
+    values = dict(_GOOD)
+    n = len(values[field].split())
+    values[field] = " ".join([bad] + ["0"] * (n - 1))
+    text = _NONFINITE.format(**values)
+    line = next(i for i, s in enumerate(_NONFINITE.splitlines(), 1) if "{" + field + "}" in s)
+    with pytest.raises(rd.ModelError) as err:
+        rd.load_urdf(text)
+    msg = str(err.value)
+    assert msg.startswith("<string>") and _ELEMENT[field] in msg and "not finite" in msg
+    assert_names_line(msg, line)
+
+
+def test_file_over_size_limit(fixture_path, monkeypatch):
+    monkeypatch.setattr(urdf_module, "MAX_FILE_BYTES", 100)
+    path = fixture_path("mimic.urdf")
+    assert path.stat().st_size > 100
+    with pytest.raises(rd.ModelError, match="exceeds the limit of 100 bytes") as err:
+        rd.load_urdf(path)
+    assert str(path) in str(err.value)
+    with pytest.raises(rd.ModelError, match="exceeds the limit") as err:
+        rd.load_urdf(path.read_text())
+    assert str(err.value).startswith("<string>")
+
+
+def test_missing_file(tmp_path):
+    path = tmp_path / "no_such_robot.urdf"
+    for source in (path, str(path)):
+        with pytest.raises(rd.ModelError, match="cannot read URDF file") as err:
+            rd.load_urdf(source)
+        assert str(path) in str(err.value)
+
+
+def test_directory_and_empty_input(tmp_path):
+    with pytest.raises(rd.ModelError, match="not a regular file") as err:
+        rd.load_urdf(tmp_path)
+    assert str(tmp_path) in str(err.value)
+    for empty in ("", "  \n"):
+        with pytest.raises(rd.ModelError, match="empty input"):
+            rd.load_urdf(empty)
+
+
+def test_not_utf8_file(tmp_path):
+    path = tmp_path / "latin1.urdf"
+    path.write_bytes('<robot name="r\xe9"><link name="a"/></robot>'.encode("latin-1"))
+    with pytest.raises(rd.ModelError, match="not UTF-8") as err:
+        rd.load_urdf(path)
+    assert str(path) in str(err.value)
+
+
+def test_xml_string_with_byte_order_mark_and_bytes():
+    text = '<robot name="r"><link name="a"/></robot>'
+    assert rd.load_urdf("\ufeff" + text).link_names == ()
+    assert rd.load_urdf(text.encode()).frame_names == ("a",)
+
+
+def test_root_element_must_be_robot():
+    with pytest.raises(rd.ModelError, match=r"<string>: <model name='r'> \(line 1\): root element must be <robot>"):
+        rd.load_urdf('<model name="r"><link name="a"/></model>')
+
+
+def test_mimic_joint_loads_as_independent_joint_with_warning(fixture_path):
+    path = fixture_path("mimic.urdf")
+    with pytest.warns(rd.RobodynWarning, match=r"mimic joints loaded as independent joints: \['right_joint'\]") as rec:
+        model = rd.load_urdf(path)
+    assert str(path) in str(rec[0].message)
+    assert model.joint_names == ("left_joint", "right_joint") and model.nv == 2
+
+
+def test_ignored_elements_warn(fixture_path):
+    path = fixture_path("ignored_elements.urdf")
+    with pytest.warns(rd.RobodynWarning) as rec:
+        model = rd.load_urdf(path)
+    msg = " ".join(str(w.message) for w in rec)
+    assert str(path) in msg
+    for tag in ("gazebo", "transmission", "material", "calibration", "safety_controller"):
+        assert f"<{tag}>" in msg
+    assert model.nv == 1 and model.total_mass == 1.0
+
+
+def test_valid_robot_loads_without_warning():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model = rd.load_urdf(_robot(_link("base"), _link("arm", 1.0), _joint("j", "revolute", "base", "arm")))
+    assert model.nv == 1
+
+
+def test_link_without_inertial_is_massless():
+    model = rd.load_urdf(_robot(_link("base"), _link("arm"), _joint("j", "revolute", "base", "arm")))
+    np.testing.assert_array_equal(model.inertia, np.zeros((1, 10)))
+    assert model.total_mass == 0.0
+
+
+def _chain_urdf(n: int, close_cycle: bool = False) -> str:
+    """A chain of n revolute joints; with close_cycle, a root plus a ring of n links."""
+    parts = ['<robot name="chain">', '<link name="l0"/>']
+    parts += [f'<link name="l{i}"/>' for i in range(1, n + 1)]
+    for i in range(1, n + 1):
+        parent = f"l{i - 1}" if not (close_cycle and i == 1) else f"l{n}"
+        parts.append(f'<joint name="j{i:05d}" type="revolute"><parent link="{parent}"/><child link="l{i}"/>'
+                     '<origin xyz="0 0 0.1"/><axis xyz="0 1 0"/></joint>')
+    return "\n".join(parts + ["</robot>"])
+
+
+def test_long_chain_loads_without_recursion():
+    model = rd.load_urdf(_chain_urdf(5000))
+    assert model.nv == model.nbodies == 5000
+    np.testing.assert_array_equal(model.parent, np.arange(-1, 4999))
+    assert model.joint_names[-1] == "j05000"
+
+
+def test_long_cycle_detected_without_recursion():
+    with pytest.raises(rd.ModelError, match="cycle") as err:
+        rd.load_urdf(_chain_urdf(5000, close_cycle=True))
+    msg = str(err.value)
+    assert msg.startswith("<string>") and "<joint name='j0" in msg and "(line " in msg
+
+
+# ----------------------------------------------------------------------------------------
+# URDF semantics against hand computations
+# ----------------------------------------------------------------------------------------
+
+
+def _robot(*parts: str) -> str:
+    return '<robot name="test">\n' + "\n".join(parts) + "\n</robot>"
+
+
+def _link(name, mass=None, xyz="0 0 0", rpy="0 0 0", inertia=(0.01, 0, 0, 0.02, 0, 0.03)) -> str:
+    if mass is None:
+        return f'<link name="{name}"/>'
+    ixx, ixy, ixz, iyy, iyz, izz = inertia
+    return (f'<link name="{name}"><inertial><origin xyz="{xyz}" rpy="{rpy}"/><mass value="{mass}"/>'
+            f'<inertia ixx="{ixx}" ixy="{ixy}" ixz="{ixz}" iyy="{iyy}" iyz="{iyz}" izz="{izz}"/></inertial></link>')
+
+
+def _joint(name, jtype, parent, child, xyz="0 0 0", rpy="0 0 0", axis="0 0 1", extra="") -> str:
+    return (f'<joint name="{name}" type="{jtype}"><parent link="{parent}"/><child link="{child}"/>'
+            f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{extra}</joint>')
+
+
+def _rx(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _ry(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def _rz(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def _theta(m, c, Ic):
+    """10 parameters about the origin, by hand: h = m c, I_o = I_c + m (|c|^2 1 - c c^T)."""
+    c = np.asarray(c, dtype=float)
+    Io = Ic + m * (c @ c * np.eye(3) - np.outer(c, c))
+    return np.array([m, *(m * c), Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
+
+
+RPY = (0.3, -0.7, 1.1)
+# inertia about the centre of mass in the inertial frame: (ixx, ixy, ixz, iyy, iyz, izz)
+I_LIST = (0.05, 0.004, -0.003, 0.07, 0.002, 0.09)
+I_MAT = np.array([[0.05, 0.004, -0.003], [0.004, 0.07, 0.002], [-0.003, 0.002, 0.09]])
+
+
+def test_rpy_is_extrinsic_xyz():
+    R = Rotation.from_euler("xyz", RPY).as_matrix()  # lower case: extrinsic
+    np.testing.assert_allclose(R, _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0]), atol=1e-15)
+    assert np.abs(R - _rx(RPY[0]) @ _ry(RPY[1]) @ _rz(RPY[2])).max() > 0.1  # the angles tell them apart
+
+
+def test_inertial_origin_rotation_is_R_I_RT():
+    com = (0.1, -0.2, 0.3)
+    text = _robot(_link("base"), _link("arm", 2.5, " ".join(map(str, com)), " ".join(map(str, RPY)), I_LIST),
+                  _joint("j", "revolute", "base", "arm"))
+    model = rd.load_urdf(text)
+    R = _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0])
+    np.testing.assert_allclose(model.inertia[0], _theta(2.5, com, R @ I_MAT @ R.T), rtol=1e-13, atol=1e-15)
+
+
+def test_joint_origin_rpy_and_xyz():
+    text = _robot(_link("base"), _link("arm", 1.0), _joint("j", "revolute", "base", "arm", "1 2 3", " ".join(map(str, RPY))))
+    model = rd.load_urdf(text)
+    np.testing.assert_allclose(model.X_tree_R[0], _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0]), atol=1e-15)
+    np.testing.assert_array_equal(model.X_tree_p[0], [1, 2, 3])
+
+
+def test_fixed_joint_merges_child_inertia_by_parallel_axis():
+    m1, c1 = 2.0, np.array([0.1, 0.0, 0.2])
+    m2, c2 = 0.5, np.array([0.0, 0.05, -0.1])
+    I1 = np.diag([0.01, 0.02, 0.03])
+    p, rpy = np.array([0.3, -0.1, 0.4]), (0.2, 0.5, -0.4)
+    text = _robot(
+        _link("base"),
+        _link("arm", m1, " ".join(map(str, c1)), "0 0 0", (0.01, 0, 0, 0.02, 0, 0.03)),
+        _link("tool", m2, " ".join(map(str, c2)), "0 0 0", I_LIST),
+        _joint("j", "revolute", "base", "arm"),
+        _joint("tool_mount", "fixed", "arm", "tool", " ".join(map(str, p)), " ".join(map(str, rpy))),
+    )
+    model = rd.load_urdf(text)
+    assert model.nbodies == 1 and model.link_names == ("arm",) and model.joint_names == ("j",)
+    R = _rz(rpy[2]) @ _ry(rpy[1]) @ _rx(rpy[0])
+    # by hand: both bodies about arm's origin, in arm's frame, then added
+    c2_arm = p + R @ c2
+    expected = _theta(m1, c1, I1) + _theta(m2, c2_arm, R @ I_MAT @ R.T)
+    np.testing.assert_allclose(model.inertia[0], expected, rtol=1e-13, atol=1e-15)
+    # the merged link stays a frame of the model, at its placement on the body
+    body, Rf, pf = model.frame_index("tool")
+    assert body == 0
+    np.testing.assert_allclose(Rf, R, atol=1e-15)
+    np.testing.assert_allclose(pf, p, atol=1e-15)
+    assert model.body_index("tool") == 0
+
+
+def test_links_fixed_to_the_world_are_world_frames():
+    text = _robot(_link("world"), _link("base", 3.0), _link("arm", 1.0),
+                  _joint("weld", "fixed", "world", "base", "0 0 1"), _joint("j", "revolute", "base", "arm", "0 0 0.5"))
+    model = rd.load_urdf(text)
+    assert model.nbodies == 1 and model.total_mass == 1.0  # a body welded to the world does not move
+    assert model.frame_index("base")[0] == -1
+    np.testing.assert_allclose(model.X_tree_p[0], [0, 0, 1.5])
+
+
+def test_axis_is_normalised():
+    text = _robot(_link("base"), _link("a"), _link("b"),
+                  _joint("ja", "revolute", "base", "a", axis="0 0 2"), _joint("jb", "prismatic", "base", "b", axis="1 1 0"))
+    model = rd.load_urdf(text)
+    np.testing.assert_allclose(model.joint_axis, [[0, 0, 1], [2 ** -0.5, 2 ** -0.5, 0]], atol=1e-15)
+
+
+def test_default_axis_is_x():
+    model = rd.load_urdf(_robot(_link("base"), _link("a"), '<joint name="j" type="revolute"><parent link="base"/>'
+                                                          '<child link="a"/></joint>'))
+    np.testing.assert_array_equal(model.joint_axis[0], [1, 0, 0])
+
+
+def test_continuous_is_revolute_without_limits():
+    limit = '<limit lower="-1" upper="1" effort="5" velocity="3"/>'
+    text = _robot(_link("base"), _link("wheel", 1.0), _joint("spin", "continuous", "base", "wheel", extra=limit))
+    model = rd.load_urdf(text)
+    assert model.nq == model.nv == 1 and joints.NAMES[model.joint_type[0]] == "revolute"
+    assert (model.lower[0], model.upper[0]) == (-np.inf, np.inf)
+    assert (model.velocity_limit[0], model.effort_limit[0]) == (3.0, 5.0)
+
+
+def test_limits_and_dynamics_are_read():
+    text = _robot(
+        _link("base"), _link("a", 1.0), _link("b", 1.0), _link("c", 1.0),
+        _joint("ja", "revolute", "base", "a", extra='<limit lower="-1.5" upper="2" effort="40" velocity="3"/>'
+                                                   '<dynamics damping="0.7" friction="1.25"/>'),
+        _joint("jb", "prismatic", "a", "b", extra='<limit effort="7" velocity="0.5"/><dynamics damping="2"/>'),
+        _joint("jc", "revolute", "b", "c"),
+    )
+    model = rd.load_urdf(text)
+    assert model.joint_names == ("ja", "jb", "jc")
+    np.testing.assert_array_equal(model.lower, [-1.5, 0.0, -np.inf])  # URDF: lower/upper default to 0
+    np.testing.assert_array_equal(model.upper, [2.0, 0.0, np.inf])
+    np.testing.assert_array_equal(model.velocity_limit, [3.0, 0.5, np.inf])
+    np.testing.assert_array_equal(model.effort_limit, [40.0, 7.0, np.inf])
+    np.testing.assert_array_equal(model.damping, [0.7, 2.0, 0.0])
+    np.testing.assert_array_equal(model.coulomb, [1.25, 0.0, 0.0])
+
+
+def test_negative_velocity_limit_is_refused():
+    text = _robot(_link("base"), _link("a"), _joint("ja", "revolute", "base", "a", extra='<limit velocity="-1"/>'))
+    with pytest.raises(rd.ModelError, match=r"<joint name='ja'> \(line \d+\): velocity must be finite and >= 0"):
+        rd.load_urdf(text)
+
+
+def test_children_are_ordered_by_joint_name():
+    text = _robot(_link("base"), _link("a"), _link("b"), _link("b2"),
+                  _joint("z_joint", "revolute", "base", "a"), _joint("m_joint", "revolute", "base", "b"),
+                  _joint("a_joint", "revolute", "b", "b2"))
+    model = rd.load_urdf(text)
+    assert model.joint_names == ("m_joint", "a_joint", "z_joint")
+    np.testing.assert_array_equal(model.parent, [-1, 0, -1])
+
+
+def test_floating_base_layout():
+    text = _robot(_link("torso", 10.0), _link("arm", 1.0), _link("head", 0.5),
+                  _joint("shoulder", "revolute", "torso", "arm", "0 0.2 0"), _joint("neck", "fixed", "torso", "head", "0 0 0.3"))
+    fixed = rd.load_urdf(text)
+    model = rd.load_urdf(text, floating_base=True)
+    assert model.floating_base and not fixed.floating_base
+    assert model.body_joint_names[0] == "root_joint" and model.link_names[0] == "torso"
+    assert joints.NAMES[model.joint_type[0]] == "free" and model.parent[0] == -1
+    n = len(fixed.joint_names)
+    assert (model.nq, model.nv) == (7 + n, 6 + n)
+    assert model.joint_names == fixed.joint_names == ("shoulder",)
+    assert (model.idx_q[1], model.idx_v[1]) == (7, 6)
+    np.testing.assert_allclose(model.inertia[0], _theta(10.0, [0, 0, 0], np.diag([0.01, 0.02, 0.03]))
+                               + _theta(0.5, [0, 0, 0.3], np.diag([0.01, 0.02, 0.03])), atol=1e-15)
+    assert model.frame_index("head")[0] == 0
+    assert np.all(np.isinf(model.lower[:6])) and np.all(np.isinf(model.upper[:6]))
+    assert model.total_mass == 11.5 and fixed.total_mass == 1.0
