@@ -12,10 +12,21 @@ from .io import DHLink, dh_transform, from_dh, load_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models
+from .algorithms.aba import aba
+from .algorithms.com import center_of_mass, com_jacobian
+from .algorithms.coriolis import christoffel_symbols, coriolis_matrix
+from .algorithms.crba import crba
+from .algorithms.energy import kinetic_energy, potential_energy
+from .algorithms.jacobian import jacobian, jacobian_dot_times_v
+from .algorithms.kinematics import forward_kinematics, frame_pose
+from .algorithms.rnea import rnea
+from .algorithms.terms import generalized_momentum, gravity, nonlinear_effects
 
 __version__ = "0.1.0"
 
 __all__ = [
     "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh",
-    "load_urdf", "models",
+    "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
+    "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
+    "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose",
 ]

@@ -145,10 +145,12 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
 def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Christoffel symbols of the first kind, ``Gamma[..., i, j, k]`` (..., nv, nv, nv).
 
-    ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2`` (for a floating base, the
-    derivatives along the base's local-frame velocity directions), symmetric in ``j, k``;
+    ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``, symmetric in ``j, k``, and
     ``coriolis_matrix(q, v)[i, j] == sum_k Gamma[i, j, k] v[k]``. Since ``C`` is linear in
-    ``v``, ``Gamma[..., :, :, k] = C(q, e_k)``.
+    ``v``, ``Gamma[..., :, :, k] = C(q, e_k)``. For a floating base the base velocity is a
+    quasi-velocity (not the derivative of ``q``); ``Gamma`` is then still defined by
+    ``C(q, e_k)`` and satisfies ``C = Gamma v``, but it is not symmetric in ``j, k`` for the
+    base directions.
     """
     batch, flat = _inputs.states(model, check_finite, q=q)
     nv = model.nv

@@ -32,26 +32,21 @@ def workspace(nb):
             np.empty(6), np.empty(6), np.empty(6))
 
 
-@njit(cache=True)
-def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
-    """Inverse dynamics of one state into ``tau`` (nv,). ``fcode < 0``: no external wrench."""
-    liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
-    nb = ints.shape[0]
-    placements(ints, body, q, liR, lip, Rj, pj)
-    if fcode > 0:
-        world_placements(ints, liR, lip, oR, op)
+@njit(cache=True, inline="always")
+def motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
+    """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the
+    base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
     for k in range(6):
-        t2[k] = 0.0
-    t2[0], t2[1], t2[2] = -grav[0], -grav[1], -grav[2]
-    # Pass 1: velocities, accelerations and body forces
-    for i in range(nb):
+        a0[k] = 0.0
+    a0[0], a0[1], a0[2] = -grav[0], -grav[1], -grav[2]
+    for i in range(ints.shape[0]):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if par >= 0:
             motion_act_inv(liR[i], lip[i], vel[par], vel[i])
             motion_act_inv(liR[i], lip[i], acc[par], acc[i])
         else:
             vel[i, :] = 0.0
-            motion_act_inv(liR[i], lip[i], t2, acc[i])
+            motion_act_inv(liR[i], lip[i], a0, acc[i])
         vJ[:] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
@@ -62,6 +57,18 @@ def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
         motion_cross(vel[i], vJ, t1)
         for r in range(6):
             acc[i, r] += t1[r]
+
+
+@njit(cache=True)
+def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
+    """Inverse dynamics of one state into ``tau`` (nv,). ``fcode < 0``: no external wrench."""
+    liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
+    nb = ints.shape[0]
+    placements(ints, body, q, liR, lip, Rj, pj)
+    if fcode > 0:
+        world_placements(ints, liR, lip, oR, op)
+    motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, t2)
+    for i in range(nb):
         theta = body[i, 15:25]
         inertia_mul(theta, acc[i], f[i])
         inertia_mul(theta, vel[i], t1)

@@ -1,0 +1,100 @@
+"""Centre of mass of the whole robot and its Jacobian.
+
+    c = sum_i (m_i p_i + R_i h_i) / m_total                       (world frame)
+    J_com[:, k] = (m^c_i S_lin,k + S_ang,k x h^c_i) / m_total     (k a dof of body i)
+
+where ``(m^c_i, h^c_i)`` are the mass and first moment (world frame) of the subtree rooted at
+body ``i`` and ``S_k = [S_lin,k; S_ang,k]`` the world-frame motion subspace column, so that
+``J_com v`` is the velocity of the centre of mass.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from . import _inputs
+from .crba import world_inertias
+from .kinematics import placements, world_motion_subspace, world_placements
+
+
+@njit(cache=True)
+def workspace(nb, nv):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)))
+
+
+@njit(cache=True)
+def com_one(ints, body, S, q, c, Jc, ws):
+    """Centre of mass ``c`` (3,) and, if ``Jc`` has columns, its Jacobian (3, nv)."""
+    liR, lip, oR, op, Rj, pj, oS, Ic = ws
+    placements(ints, body, q, liR, lip, Rj, pj)
+    world_placements(ints, liR, lip, oR, op)
+    world_inertias(ints, body, oR, op, Ic)
+    if Jc.shape[1] > 0:
+        world_motion_subspace(ints, S, oR, op, oS)
+    for i in range(ints.shape[0] - 1, -1, -1):
+        if Jc.shape[1] > 0:
+            m, hx, hy, hz = Ic[i, 0], Ic[i, 1], Ic[i, 2], Ic[i, 3]
+            for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
+                wx, wy, wz = oS[k, 3], oS[k, 4], oS[k, 5]
+                Jc[0, k] = m * oS[k, 0] + wy * hz - wz * hy
+                Jc[1, k] = m * oS[k, 1] + wz * hx - wx * hz
+                Jc[2, k] = m * oS[k, 2] + wx * hy - wy * hx
+        par = ints[i, 0]
+        if par >= 0:
+            for r in range(4):
+                Ic[par, r] += Ic[i, r]
+    mass = 0.0
+    c[:] = 0.0
+    for i in range(ints.shape[0]):
+        if ints[i, 0] < 0:
+            mass += Ic[i, 0]
+            for r in range(3):
+                c[r] += Ic[i, 1 + r]
+    for r in range(3):
+        c[r] /= mass
+        for k in range(Jc.shape[1]):
+            Jc[r, k] /= mass
+
+
+@njit(cache=True, parallel=True)
+def _com_batch(ints, body, S, Q, C, JC, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], S.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            com_one(ints, body, S, Q[s], C[s], JC[s], ws)
+
+
+@njit(cache=True)
+def _com_single(ints, body, S, q, c, Jc):
+    com_one(ints, body, S, q, c, Jc, workspace(ints.shape[0], S.shape[0]))
+
+
+def _run(model, q, check_finite, with_jacobian):
+    if model.total_mass <= 0:
+        raise ValueError("the model has no mass: its centre of mass is undefined")
+    batch, flat = _inputs.states(model, check_finite, q=q)
+    ints, body, S, _ = model._kernel
+    Q = flat["q"]
+    B = Q.shape[0]
+    C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
+    nchunk = _inputs.chunks(B)
+    if nchunk:
+        _com_batch(ints, body, S, Q, C, JC, nchunk)
+    else:
+        _com_single(ints, body, S, Q[0], C[0], JC[0])
+    return batch, C, JC
+
+
+def center_of_mass(model, q, *, check_finite: bool = True) -> np.ndarray:
+    """World position of the centre of mass of all bodies: (..., 3) for q (..., nq)."""
+    batch, C, _ = _run(model, q, check_finite, False)
+    return _inputs.unflatten(C, batch)
+
+
+def com_jacobian(model, q, *, check_finite: bool = True) -> np.ndarray:
+    """Jacobian of the centre of mass, (..., 3, nv): ``J_com v`` is its world-frame velocity."""
+    batch, _, JC = _run(model, q, check_finite, True)
+    return _inputs.unflatten(JC, batch)

@@ -1,0 +1,158 @@
+"""Frame Jacobians and the Jacobian-derivative bias ``Jdot v``.
+
+The Jacobian ``J`` (6 x nv) maps ``v`` to the velocity of a frame attached to a body, rows
+``[linear; angular]``. ``frame`` chooses the coordinates (the names follow Pinocchio's):
+
+* ``"world"``: world axes; the linear part is the velocity of the body point that coincides
+  with the world origin (the spatial velocity). Column ``k`` is the world-frame motion
+  subspace ``oS_k`` of an ancestor joint, zero for other joints (RBDA section 8.1).
+* ``"local"``: the frame's own axes, linear velocity of the frame origin.
+* ``"local_world_aligned"``: world axes, linear velocity of the frame origin.
+
+``jacobian_dot_times_v`` gives ``Jdot v`` in the same coordinates: the acceleration of the
+frame when ``qdd = 0`` (and no gravity), spatial for ``"local"``/``"world"`` and classical
+(``d/dt`` of the linear velocity of the frame origin) for ``"local_world_aligned"``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ..spatial import motion_act
+from . import _inputs
+from .kinematics import placements, world_placements
+from .rnea import motion_pass
+
+FRAMES = ("world", "local", "local_world_aligned")
+
+
+@njit(cache=True)
+def workspace(nb, nv):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
+            np.empty(6), np.zeros(nv), np.zeros(3))
+
+
+@njit(cache=True)
+def jacobian_one(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b, ws):
+    """World Jacobian ``J`` (6, nv) of body ``b``, its pose, and (when ``v`` has entries) the
+    body-frame velocity and acceleration of ``b`` at ``qdd = 0`` without gravity."""
+    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
+    placements(ints, body, q, liR, lip, Rj, pj)
+    world_placements(ints, liR, lip, oR, op)
+    J[:, :] = 0.0
+    j = b
+    while j >= 0:
+        for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+            motion_act(oR[j], op[j], S[k], J[:, k])
+        j = ints[j, 0]
+    oRb[:, :] = oR[b]
+    opb[:] = op[b]
+    if v.shape[0] > 0:
+        motion_pass(ints, S, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
+        acc_b[:] = acc[b]
+        vel_b[:] = vel[b]
+
+
+@njit(cache=True, parallel=True)
+def _jacobian_batch(ints, body, S, Q, V, b, JJ, OR, OP, ACC, VEL, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], S.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            jacobian_one(ints, body, S, Q[s], V[s], b, JJ[s], OR[s], OP[s], ACC[s], VEL[s], ws)
+
+
+@njit(cache=True)
+def _jacobian_single(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b):
+    jacobian_one(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b, workspace(ints.shape[0], S.shape[0]))
+
+
+def _run(model, Q, V, b):
+    ints, body, S, _ = model._kernel
+    B = Q.shape[0]
+    JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
+    ACC, VEL = np.empty((B, 6)), np.empty((B, 6))
+    nchunk = _inputs.chunks(B)
+    if nchunk:
+        _jacobian_batch(ints, body, S, Q, V, b, JJ, OR, OP, ACC, VEL, nchunk)
+    else:
+        _jacobian_single(ints, body, S, Q[0], V[0], b, JJ[0], OR[0], OP[0], ACC[0], VEL[0])
+    return JJ, OR, OP, ACC, VEL
+
+
+def _frame(model, body):
+    """``(b, R, p)``: body index and placement in it of a body index or link/frame name."""
+    if isinstance(body, (int, np.integer)):
+        return model.body_index(body), np.eye(3), np.zeros(3)
+    b, R, p = model.frame_index(body)
+    if b < 0:
+        raise ValueError(f"frame {body!r} is fixed to the world; its Jacobian is zero")
+    return b, R, p
+
+
+def _cross(a, b):
+    """Row-wise cross product of (B, 3) ``a`` with each column of (B, 3, n) ``b``."""
+    return np.cross(a[:, :, None], b, axis=1)
+
+
+def jacobian(model, q, body, frame: str = "world", *, check_finite: bool = True) -> np.ndarray:
+    """Jacobian of a body or frame: (..., 6, nv), rows ``[linear; angular]``.
+
+    ``body`` is a body index or a link/frame name; ``frame`` is ``"world"``, ``"local"`` or
+    ``"local_world_aligned"`` (module docstring). ``J v`` is the frame's velocity and
+    ``J^T [f; n]`` the joint forces balancing a wrench ``[f; n]`` in the same coordinates.
+    """
+    if frame not in FRAMES:
+        raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
+    b, Rbf, pbf = _frame(model, body)
+    batch, flat = _inputs.states(model, check_finite, q=q)
+    Q = flat["q"]
+    JJ, OR, OP, _, _ = _run(model, Q, np.zeros((Q.shape[0], 0)), b)
+    if frame != "world":
+        Rf, pf = OR @ Rbf, OP + OR @ pbf
+        lin = JJ[:, :3] - _cross(pf, JJ[:, 3:])
+        JJ = np.concatenate([lin, JJ[:, 3:]], axis=1)
+        if frame == "local":
+            JJ = _rotate_T(Rf, JJ)
+    return _inputs.unflatten(JJ, batch)
+
+
+def _rotate_T(R, X):
+    """``[R^T X_lin; R^T X_ang]`` for R (B, 3, 3) and X (B, 6, ...)."""
+    out = np.empty_like(X)
+    out[:, :3] = np.einsum("bji,bj...->bi...", R, X[:, :3])
+    out[:, 3:] = np.einsum("bji,bj...->bi...", R, X[:, 3:])
+    return out
+
+
+def jacobian_dot_times_v(model, q, v, body, frame: str = "world", *, check_finite: bool = True) -> np.ndarray:
+    """``Jdot(q, v) v`` (..., 6), rows ``[linear; angular]``, for the Jacobian of
+    :func:`jacobian` with the same ``body`` and ``frame``: the frame's acceleration when
+    ``qdd = 0``, so that its acceleration is ``J qdd + Jdot v``."""
+    if frame not in FRAMES:
+        raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
+    b, Rbf, pbf = _frame(model, body)
+    batch, flat = _inputs.states(model, check_finite, q=q, v=v)
+    _, OR, OP, ACC, VEL = _run(model, flat["q"], flat["v"], b)
+    # spatial acceleration and velocity in the frame's own coordinates (frame rigid on body b)
+    acc_f = _rotate_T(np.broadcast_to(Rbf, OR.shape), _shift(ACC, pbf))
+    if frame == "local":
+        out = acc_f
+    elif frame == "world":
+        lin, ang = np.einsum("bij,bj->bi", OR, ACC[:, :3]), np.einsum("bij,bj->bi", OR, ACC[:, 3:])
+        out = np.concatenate([lin + np.cross(OP, ang), ang], axis=1)
+    else:
+        vel_f = _rotate_T(np.broadcast_to(Rbf, OR.shape), _shift(VEL, pbf))
+        Rf = OR @ Rbf
+        classical = acc_f[:, :3] + np.cross(vel_f[:, 3:], vel_f[:, :3])
+        out = np.concatenate([np.einsum("bij,bj->bi", Rf, classical), np.einsum("bij,bj->bi", Rf, acc_f[:, 3:])], axis=1)
+    return _inputs.unflatten(out, batch)
+
+
+def _shift(m, p):
+    """Motion vectors (B, 6) re-expressed at the point ``p`` (same axes): ``v - p x w``."""
+    out = m.copy()
+    out[:, :3] -= np.cross(p, m[:, 3:])
+    return out
