@@ -161,7 +161,8 @@ class Model:
         nq, nv = int(nq_i.sum()), int(nv_i.sum())
 
         def arr(x, shape, what, fill=0.0):
-            a = np.full(shape, fill, dtype=float) if x is None else np.asarray(x, dtype=float)
+            # a copy: the checks below normalise in place, and inputs may be read-only model arrays
+            a = np.full(shape, fill, dtype=float) if x is None else np.array(x, dtype=float)
             if a.shape != shape:
                 raise ModelError(f"{what} must have shape {shape}, got {a.shape}")
             return a
