@@ -7,7 +7,10 @@ import site
 import sysconfig
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+import robodyn as rd
 
 FIXTURES = Path(__file__).parent / "fixtures"
 
@@ -72,3 +75,24 @@ def fixture_path():
         return p
 
     return get
+
+
+def small_tree_builder(physical: str = "error"):
+    """A branching tree with every 1-dof joint type and a merged fixed link::
+
+        base -(shoulder, revolute z)-> upper -(slide, prismatic x)-> lower
+             \\-(hip, revolute y)-> side         upper -(mount, fixed)-> sensor
+    """
+    b = rd.ModelBuilder("tree", physical=physical)
+    b.add_link("base")
+    b.add_link("upper", mass=2.0, com=(0.0, 0.0, 0.25), inertia=np.diag([0.02, 0.02, 0.004]))
+    b.add_link("lower", mass=1.0, com=(0.2, 0.0, 0.0), inertia=np.diag([0.001, 0.01, 0.01]))
+    b.add_link("sensor", mass=0.1, com=(0.01, 0.0, 0.0), inertia=np.eye(3) * 1e-5)
+    b.add_link("side", mass=0.5, com=(0.0, 0.1, 0.0), inertia=np.diag([0.003, 0.001, 0.003]))
+    b.add_joint("shoulder", "revolute", "base", "upper", xyz=(0, 0, 0.1), axis=(0, 0, 1), lower=-2, upper=2,
+                velocity=3, effort=50, damping=0.1, friction=0.2)
+    b.add_joint("slide", "prismatic", "upper", "lower", xyz=(0, 0, 0.5), rpy=(0, np.pi / 2, 0), axis=(1, 0, 0),
+                lower=0, upper=0.3)
+    b.add_joint("mount", "fixed", "upper", "sensor", xyz=(0.05, 0, 0.4))
+    b.add_joint("hip", "revolute", "base", "side", xyz=(0.2, 0, 0), axis=(0, 1, 0))
+    return b
