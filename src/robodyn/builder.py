@@ -120,12 +120,13 @@ class ModelBuilder:
         where = where or f"{self.source}: joint {name!r}"
         if type not in JOINT_TYPES:
             raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted(JOINT_TYPES)}")
-        R = rpy_to_matrix(rpy) if rotation is None else np.asarray(rotation, dtype=float)
+        rot = np.asarray(rpy if rotation is None else rotation, dtype=float)
         p = np.asarray(xyz, dtype=float).reshape(3)
         ax = np.asarray(axis, dtype=float).reshape(3)
-        for what, a in (("origin", np.concatenate([p, R.ravel()])), ("axis", ax)):
+        for what, a in (("origin", np.concatenate([p, rot.ravel()])), ("axis", ax)):
             if not np.all(np.isfinite(a)):
                 raise ModelError(f"{where}: {what} is not finite")
+        R = rpy_to_matrix(rot) if rotation is None else rot
         if type != "fixed":
             n = np.linalg.norm(ax)
             if n < 1e-12:
