@@ -1,0 +1,169 @@
+"""The ``robodyn`` command line.
+
+    robodyn info MODEL          joint table, masses and inertias of a built-in robot or URDF
+    robodyn demo [MODEL]        inverse and forward dynamics and the mass matrix at a sample state
+    robodyn bench [MODEL]       per-call timings (and the comparison with Pinocchio if installed)
+
+MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import warnings
+
+import numpy as np
+
+from . import models
+from .errors import ModelError
+
+
+def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
+    """A built-in robot by name, or a URDF file by path."""
+    from .io.urdf import load_urdf
+
+    if spec in models.names():
+        if floating_base:
+            raise ValueError("--floating-base applies to URDF files; built-in robots have a fixed base")
+        return models.load(spec)
+    if spec.endswith(".urdf") or "/" in spec:
+        return load_urdf(spec, floating_base=floating_base, physical=physical)
+    raise ValueError(f"unknown model {spec!r}: give a URDF path or one of {models.names()}")
+
+
+def _fmt(x, width=9, prec=4) -> str:
+    return " ".join(f"{v:{width}.{prec}f}" for v in np.atleast_1d(x))
+
+
+def cmd_info(args) -> int:
+    if args.list:
+        for name in models.names():
+            m = models.load(name)
+            print(f"{name:<16} nv={m.nv:<3} mass={m.total_mass:8.3f} kg")
+        return 0
+    if not args.model:
+        print("robodyn info: give a MODEL (or --list)", file=sys.stderr)
+        return 2
+    model = load_model(args.model, args.floating_base, args.physical)
+    print(model)
+    print("\nInertial parameters per body (about the body origin, body frame):")
+    print(f"  {'body':<24} {'m':>9} {'mcx':>9} {'mcy':>9} {'mcz':>9} {'Ixx':>9} {'Ixy':>9} {'Iyy':>9} {'Ixz':>9} {'Iyz':>9} {'Izz':>9}")
+    for i, name in enumerate(model.link_names):
+        print(f"  {name:<24} {_fmt(model.inertia[i])}")
+    if model.nv:
+        print("\nJoint data (per velocity entry):")
+        print(f"  {'#':>3} {'lower':>9} {'upper':>9} {'vel.max':>9} {'effort':>9} {'damping':>9} {'coulomb':>9} {'armature':>9}")
+        for k in range(model.nv):
+            vals = [model.lower[k], model.upper[k], model.velocity_limit[k], model.effort_limit[k],
+                    model.damping[k], model.coulomb[k], model.armature[k]]
+            print(f"  {k:>3} {_fmt(vals)}")
+    return 0
+
+
+def sample_state(model, seed: int = 0):
+    """A reproducible sample state: mid-range joint angles, moderate speeds and accelerations."""
+    from .random import random_configuration
+
+    rng = np.random.default_rng(seed)
+    q = random_configuration(model, rng) * 0.5
+    if model.floating_base:
+        q = random_configuration(model, rng)
+    v = rng.uniform(-1.0, 1.0, model.nv)
+    a = rng.uniform(-2.0, 2.0, model.nv)
+    return q, v, a
+
+
+def cmd_demo(args) -> int:
+    import robodyn as rd
+
+    model = load_model(args.model, args.floating_base, args.physical)
+    q, v, a = sample_state(model, args.seed)
+    np.set_printoptions(precision=4, suppress=True, linewidth=120)
+    print(f"robodyn demo on {model.name!r}: nq={model.nq}, nv={model.nv}, {model.nbodies} bodies, "
+          f"mass {model.total_mass:.3f} kg")
+    print(f"  q   = {q}\n  qd  = {v}\n  qdd = {a}")
+
+    M = rd.crba(model, q, armature=False)
+    inertial = M @ a
+    coriolis = rd.coriolis_matrix(model, q, v) @ v
+    grav = rd.gravity(model, q)
+    tau = rd.rnea(model, q, v, a, friction=False, armature=False)
+    print("\nInverse dynamics (RNEA): tau = M(q) qdd + C(q, qd) qd + g(q)   [N m or N]")
+    print(f"  {'joint':<22} {'inertial':>10} {'coriolis':>10} {'gravity':>10} {'total':>10}")
+    names = _dof_names(model)
+    for k in range(model.nv):
+        print(f"  {names[k]:<22} {inertial[k]:10.4f} {coriolis[k]:10.4f} {grav[k]:10.4f} {tau[k]:10.4f}")
+    residual = np.abs(inertial + coriolis + grav - tau).max()
+    print(f"  max |M qdd + C qd + g - rnea| = {residual:.2e}")
+
+    qdd = rd.aba(model, q, v, tau, friction=False, armature=False)
+    print("\nForward dynamics (ABA) of those torques recovers qdd:")
+    print(f"  qdd = {qdd}\n  max |aba(rnea(qdd)) - qdd| = {np.abs(qdd - a).max():.2e}")
+    qdd0 = rd.aba(model, q, v, np.zeros(model.nv), friction=False, armature=False)
+    print(f"  with tau = 0 (falling under gravity): qdd = {qdd0}")
+
+    print("\nMass matrix M(q) (CRBA):")
+    print(M)
+    print(f"  eigenvalues: {np.linalg.eigvalsh(M)}")
+    print(f"\nKinetic energy {rd.kinetic_energy(model, q, v):.6f} J, "
+          f"potential energy {rd.potential_energy(model, q):.6f} J")
+    return 0
+
+
+def _dof_names(model) -> list[str]:
+    from .joints import NV
+
+    names = []
+    for i in range(model.nbodies):
+        n = int(NV[model.joint_type[i]])
+        if n == 1:
+            names.append(model.body_joint_names[i])
+        else:
+            names.extend(f"{model.body_joint_names[i]}[{c}]" for c in ("vx", "vy", "vz", "wx", "wy", "wz")[:n])
+    return names
+
+
+def cmd_bench(args) -> int:
+    from .bench import run_bench
+
+    model = load_model(args.model, args.floating_base, args.physical)
+    return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics.")
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    def common(p, default=None):
+        p.add_argument("model", nargs="?", default=default, help="built-in robot name or URDF path")
+        p.add_argument("--floating-base", action="store_true", help="URDF: add a free-flying base")
+        p.add_argument("--physical", choices=("error", "warn"), default="error",
+                       help="URDF: reject (error) or keep with a warning (warn) unphysical inertias")
+
+    p = sub.add_parser("info", help="print the joint table, masses and inertias")
+    common(p)
+    p.add_argument("--list", action="store_true", help="list the built-in robots")
+    p.set_defaults(func=cmd_info)
+    p = sub.add_parser("demo", help="inverse/forward dynamics and mass matrix at a sample state")
+    common(p, default="panda")
+    p.add_argument("--seed", type=int, default=0)
+    p.set_defaults(func=cmd_demo)
+    p = sub.add_parser("bench", help="per-call timings (and the comparison with Pinocchio)")
+    common(p, default="panda")
+    p.add_argument("--batch", type=int, default=10000, help="batch size for the batched timings")
+    p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
+    p.set_defaults(func=cmd_bench)
+
+    args = parser.parse_args(argv)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("default")
+            return args.func(args)
+    except (ModelError, ValueError) as e:
+        print(f"robodyn: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())
