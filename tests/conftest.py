@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 import robodyn as rd
 
@@ -53,6 +54,12 @@ def example_robot_urdfs() -> list[Path]:
 def erd_id(path: Path) -> str:
     """Short test id of an example-robot-data URDF: ``package/.../file.urdf``."""
     return path.relative_to(example_robot_data_dir()).as_posix()
+
+
+def rot(axis: str, angle: float) -> np.ndarray:
+    """Rotation matrix about ``axis`` ("x", "y" or "z") by ``angle`` (computed by scipy,
+    independently of robodyn)."""
+    return Rotation.from_euler(axis, angle).as_matrix()
 
 
 def marked_lines(text: str, marker: str = "<!-- ERROR -->") -> list[int]:

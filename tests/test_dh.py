@@ -9,21 +9,12 @@ import numpy as np
 import pytest
 
 import robodyn as rd
+from conftest import rot
 from robodyn import joints as J
 from robodyn.model import inertial_parameters_from
 
 A1, ALPHA1, D1, OFF1 = 0.4, np.pi / 2, 0.1, 0.3
 A2, ALPHA2, THETA2, OFF2 = 0.2, -0.5, 0.7, 0.05
-
-
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
 def _table(**extra1):
@@ -56,26 +47,26 @@ def test_standard_offsets_and_placements():
     model = rd.from_dh(_table(), convention="standard")
     # T_01 = Rz(q1 + offset1) Tz(d1) Tx(a1) Rx(alpha1): the offset rotates the joint frame,
     # d, a and alpha place frame 1 on body 1
-    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], _rz(OFF1), [0, 0, 0])
+    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], rot("z", OFF1), [0, 0, 0])
     _, R1, p1 = model.frame_index("frame1")
-    _assert_placement(R1, p1, _rx(ALPHA1), [A1, 0, D1])
+    _assert_placement(R1, p1, rot("x", ALPHA1), [A1, 0, D1])
     # T_12 = Rz(theta2) Tz(q2 + offset2) Tx(a2) Rx(alpha2), joint 2 placed in body 1's frame
-    _assert_placement(model.X_tree_R[1], model.X_tree_p[1], _rx(ALPHA1) @ _rz(THETA2),
-                      np.array([A1, 0, D1]) + _rx(ALPHA1) @ [0, 0, OFF2])
+    _assert_placement(model.X_tree_R[1], model.X_tree_p[1], rot("x", ALPHA1) @ rot("z", THETA2),
+                      np.array([A1, 0, D1]) + rot("x", ALPHA1) @ [0, 0, OFF2])
     _, R2, p2 = model.frame_index("frame2")
-    _assert_placement(R2, p2, _rx(ALPHA2), [A2, 0, 0])
+    _assert_placement(R2, p2, rot("x", ALPHA2), [A2, 0, 0])
 
 
 def test_modified_offsets_and_placements():
     model = rd.from_dh(_table(), convention="modified")
     # T_01 = Rx(alpha0) Tx(a0) Rz(q1 + offset1) Tz(d1): frame 1 is the joint frame
-    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], _rx(ALPHA1) @ _rz(OFF1),
-                      np.array([A1, 0, 0]) + _rx(ALPHA1) @ [0, 0, D1])
+    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], rot("x", ALPHA1) @ rot("z", OFF1),
+                      np.array([A1, 0, 0]) + rot("x", ALPHA1) @ [0, 0, D1])
     _, R1, p1 = model.frame_index("frame1")
     _assert_placement(R1, p1, np.eye(3), [0, 0, 0])
     # T_12 = Rx(alpha1) Tx(a1) Rz(theta2) Tz(q2 + offset2)
-    _assert_placement(model.X_tree_R[1], model.X_tree_p[1], _rx(ALPHA2) @ _rz(THETA2),
-                      np.array([A2, 0, 0]) + _rx(ALPHA2) @ [0, 0, OFF2])
+    _assert_placement(model.X_tree_R[1], model.X_tree_p[1], rot("x", ALPHA2) @ rot("z", THETA2),
+                      np.array([A2, 0, 0]) + rot("x", ALPHA2) @ [0, 0, OFF2])
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])
@@ -99,18 +90,18 @@ def test_placements_at_zero_compose_to_dh_product(convention):
 
 def test_base_placement():
     base = np.eye(4)
-    base[:3, :3], base[:3, 3] = _rz(0.5), [1.0, 2.0, 3.0]
+    base[:3, :3], base[:3, 3] = rot("z", 0.5), [1.0, 2.0, 3.0]
     model = rd.from_dh(_table(), base=base)
-    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], _rz(0.5) @ _rz(OFF1), [1, 2, 3])
+    _assert_placement(model.X_tree_R[0], model.X_tree_p[0], rot("z", 0.5) @ rot("z", OFF1), [1, 2, 3])
     _, R0, p0 = model.frame_index("frame0")
-    _assert_placement(R0, p0, _rz(0.5), [1, 2, 3])
+    _assert_placement(R0, p0, rot("z", 0.5), [1, 2, 3])
 
 
 def test_inertia_given_in_dh_frame_is_moved_to_the_body():
     com, Ic = np.array([-0.2, 0.0, 0.01]), np.diag([0.002, 0.03, 0.03])
     model = rd.from_dh(_table(mass=2.0, com=com, inertia=Ic), convention="standard")
     # frame 1 sits at (Rx(alpha1), (a1, 0, d1)) on body 1
-    R, p = _rx(ALPHA1), np.array([A1, 0, D1])
+    R, p = rot("x", ALPHA1), np.array([A1, 0, D1])
     np.testing.assert_allclose(model.inertia[0], inertial_parameters_from(2.0, p + R @ com, R @ Ic @ R.T),
                                rtol=1e-13, atol=1e-16)
     assert model.total_mass == 2.0

@@ -13,7 +13,7 @@ from scipy.spatial.transform import Rotation
 import robodyn as rd
 import robodyn.io.urdf as urdf_module
 from robodyn import joints
-from conftest import FIXTURES, assert_names_line, erd_id, example_robot_urdfs, marked_lines
+from conftest import assert_names_line, erd_id, example_robot_urdfs, marked_lines, rot
 
 # ----------------------------------------------------------------------------------------
 # example-robot-data, compared with Pinocchio
@@ -383,21 +383,6 @@ def _joint(name, jtype, parent, child, xyz="0 0 0", rpy="0 0 0", axis="0 0 1", e
             f'<origin xyz="{xyz}" rpy="{rpy}"/><axis xyz="{axis}"/>{extra}</joint>')
 
 
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
 def _theta(m, c, Ic):
     """10 parameters about the origin, by hand: h = m c, I_o = I_c + m (|c|^2 1 - c c^T)."""
     c = np.asarray(c, dtype=float)
@@ -413,8 +398,8 @@ I_MAT = np.array([[0.05, 0.004, -0.003], [0.004, 0.07, 0.002], [-0.003, 0.002, 0
 
 def test_rpy_is_extrinsic_xyz():
     R = Rotation.from_euler("xyz", RPY).as_matrix()  # lower case: extrinsic
-    np.testing.assert_allclose(R, _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0]), atol=1e-15)
-    assert np.abs(R - _rx(RPY[0]) @ _ry(RPY[1]) @ _rz(RPY[2])).max() > 0.1  # the angles tell them apart
+    np.testing.assert_allclose(R, rot("z", RPY[2]) @ rot("y", RPY[1]) @ rot("x", RPY[0]), atol=1e-15)
+    assert np.abs(R - rot("x", RPY[0]) @ rot("y", RPY[1]) @ rot("z", RPY[2])).max() > 0.1  # the angles tell them apart
 
 
 def test_inertial_origin_rotation_is_R_I_RT():
@@ -422,14 +407,14 @@ def test_inertial_origin_rotation_is_R_I_RT():
     text = _robot(_link("base"), _link("arm", 2.5, " ".join(map(str, com)), " ".join(map(str, RPY)), I_LIST),
                   _joint("j", "revolute", "base", "arm"))
     model = rd.load_urdf(text)
-    R = _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0])
+    R = rot("z", RPY[2]) @ rot("y", RPY[1]) @ rot("x", RPY[0])
     np.testing.assert_allclose(model.inertia[0], _theta(2.5, com, R @ I_MAT @ R.T), rtol=1e-13, atol=1e-15)
 
 
 def test_joint_origin_rpy_and_xyz():
     text = _robot(_link("base"), _link("arm", 1.0), _joint("j", "revolute", "base", "arm", "1 2 3", " ".join(map(str, RPY))))
     model = rd.load_urdf(text)
-    np.testing.assert_allclose(model.X_tree_R[0], _rz(RPY[2]) @ _ry(RPY[1]) @ _rx(RPY[0]), atol=1e-15)
+    np.testing.assert_allclose(model.X_tree_R[0], rot("z", RPY[2]) @ rot("y", RPY[1]) @ rot("x", RPY[0]), atol=1e-15)
     np.testing.assert_array_equal(model.X_tree_p[0], [1, 2, 3])
 
 
@@ -447,7 +432,7 @@ def test_fixed_joint_merges_child_inertia_by_parallel_axis():
     )
     model = rd.load_urdf(text)
     assert model.nbodies == 1 and model.link_names == ("arm",) and model.joint_names == ("j",)
-    R = _rz(rpy[2]) @ _ry(rpy[1]) @ _rx(rpy[0])
+    R = rot("z", rpy[2]) @ rot("y", rpy[1]) @ rot("x", rpy[0])
     # by hand: both bodies about arm's origin, in arm's frame, then added
     c2_arm = p + R @ c2
     expected = _theta(m1, c1, I1) + _theta(m2, c2_arm, R @ I_MAT @ R.T)
