@@ -41,9 +41,17 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
     raise ValueError(f"unknown joint type code {jtype}")
 
 
+# A free joint's quaternion may be this far from unit norm; it is normalised, farther is an error.
+QUAT_TOL = 1e-3
+
+
 @njit(cache=True, inline="always")
 def joint_transform(jtype, axis, q, iq, R, p):
-    """Placement ``(R, p)`` of the child frame in the joint frame at configuration ``q``."""
+    """Placement ``(R, p)`` of the child frame in the joint frame at configuration ``q``.
+
+    Returns False when a free joint's quaternion is farther than ``QUAT_TOL`` from unit norm
+    (a near-unit quaternion is normalised).
+    """
     if jtype == REVOLUTE:
         rotation_axis_angle(axis, q[iq], R)
         p[0] = 0.0
@@ -55,19 +63,23 @@ def joint_transform(jtype, axis, q, iq, R, p):
                 R[r, c] = 1.0 if r == c else 0.0
             p[r] = axis[r] * q[iq]
     else:  # FREE
-        rotation_from_quaternion(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6], R)
+        n = np.sqrt(q[iq + 3] ** 2 + q[iq + 4] ** 2 + q[iq + 5] ** 2 + q[iq + 6] ** 2)
+        if not abs(n - 1.0) <= QUAT_TOL:
+            return False
+        rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, R)
         p[0] = q[iq]
         p[1] = q[iq + 1]
         p[2] = q[iq + 2]
+    return True
 
 
 @njit(cache=True, inline="always")
-def friction_torque(dof, eps, v, k):
+def friction_torque(dofs, eps, v, k):
     """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
 
-    ``dof[k] = [armature, b (viscous), Fc (Coulomb)]``; ``sgn`` is ``sign`` when ``eps == 0``
-    and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
+    ``dofs[k, 6:9] = [armature, b (viscous), Fc (Coulomb)]``; ``sgn`` is ``sign`` when
+    ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
     """
     vk = v[k]
     s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
-    return dof[k, 1] * vk + dof[k, 2] * s
+    return dofs[k, 7] * vk + dofs[k, 8] * s

@@ -111,7 +111,7 @@ class Model:
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
         "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
-        "physical", "_kernel", "_frame_index", "_dof_variants",
+        "physical", "_kernel", "_frame_index",
     )
 
     def __init__(
@@ -262,7 +262,6 @@ class Model:
         index = {n: i for i, n in enumerate(all_names)}
         setattr_(self, "_frame_index", index)
         setattr_(self, "_kernel", self._pack())
-        setattr_(self, "_dof_variants", {})
 
     def __setattr__(self, key, value):
         raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
@@ -330,15 +329,17 @@ class Model:
         return b
 
     # -- kernel layout -----------------------------------------------------------------
-    def _pack(self):
-        """Arrays handed to the compiled kernels (few arguments, contiguous).
+    def _pack(self) -> dict:
+        """Arrays handed to the compiled kernels (few arguments, contiguous, read-only).
 
         ``ints`` (nb, 5): parent, joint type, idx_q, idx_v, nv of the joint;
         ``body`` (nb, 25): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10);
-        ``S`` (nv, 6): motion subspace columns in the child frame;
-        ``dof`` (nv, 3): armature, damping, Coulomb friction.
+        ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
+        then armature, viscous and Coulomb friction, zeroed when switched off;
+        ``params[with_gravity]`` (4,): gravity (3, or zeros) and the Coulomb smoothing;
+        ``zero_wrench`` (nb, 6): no external wrench.
         """
-        nb = self.nbodies
+        nb, nv = self.nbodies, self.nv
         ints = np.zeros((nb, 5), dtype=np.int64)
         ints[:, 0] = self.parent
         ints[:, 1] = self.joint_type
@@ -350,28 +351,25 @@ class Model:
         body[:, 9:12] = self.X_tree_p
         body[:, 12:15] = self.joint_axis
         body[:, 15:25] = self.inertia
-        S = np.zeros((self.nv, 6))
+        full = np.zeros((nv, 9))
         for i in range(nb):
             k = self.idx_v[i]
             Si = J.motion_subspace(int(self.joint_type[i]), self.joint_axis[i])
-            S[k:k + Si.shape[0]] = Si
-        dof = np.stack([self.armature, self.damping, self.coulomb], axis=1) if self.nv else np.zeros((0, 3))
-        for a in (ints, body, S, dof):
+            full[k:k + Si.shape[0], :6] = Si
+        full[:, 6], full[:, 7], full[:, 8] = self.armature, self.damping, self.coulomb
+        dofs = {}
+        for friction in (False, True):
+            for armature in (False, True):
+                d = full.copy()
+                d[:, 6] *= armature
+                d[:, 7:] *= friction
+                dofs[(friction, armature)] = d
+        params = {True: np.array([*self.gravity, self.coulomb_smoothing]),
+                  False: np.array([0.0, 0.0, 0.0, self.coulomb_smoothing])}
+        out = dict(ints=ints, body=body, dofs=dofs, params=params, zero_wrench=np.zeros((nb, 6)))
+        for a in (ints, body, *dofs.values(), *params.values(), out["zero_wrench"]):
             a.flags.writeable = False
-        return ints, np.ascontiguousarray(body), S, np.ascontiguousarray(dof)
-
-    def _dof(self, friction: bool, armature: bool) -> np.ndarray:
-        key = (bool(friction), bool(armature))
-        d = self._dof_variants.get(key)
-        if d is None:
-            d = self._kernel[3].copy()
-            if not armature:
-                d[:, 0] = 0.0
-            if not friction:
-                d[:, 1:] = 0.0
-            d.flags.writeable = False
-            self._dof_variants[key] = d
-        return d
+        return out
 
     # -- display -----------------------------------------------------------------------
     def __repr__(self) -> str:

@@ -2,116 +2,157 @@
 
 Every public function accepts states with leading batch dimensions: ``q`` of shape
 ``(..., nq)``, ``v``/``a``/``tau`` of shape ``(..., nv)``; the leading shapes broadcast
-against each other. The checks raise ``ValueError`` naming the argument, the expected shape
-and the received one; NaN/Inf raise unless ``check_finite=False`` (for hot loops that
-guarantee finite inputs). Free-joint quaternions within ``QUAT_TOL`` of unit norm are
-normalised, others are an error.
+against each other. Shapes are checked here and raise ``ValueError`` naming the argument, the
+expected shape and the received one.
+
+The value checks run inside the compiled kernels, where they cost nanoseconds: each kernel
+returns a status per state (``OK``, ``NONFINITE`` for NaN/Inf in an input, ``BAD_QUATERNION``
+for a free joint's quaternion farther than ``joints.QUAT_TOL`` from unit norm — near-unit
+ones are normalised — or ``i + 1`` for a failure at body ``i``), and :func:`raise_for_status`
+turns a failure into a ``ValueError`` that says what and where. ``check_finite=False`` skips
+the NaN/Inf check (for hot loops with trusted input).
 """
 
 from __future__ import annotations
 
 import numba
 import numpy as np
+from numba import njit
 
 from .. import joints as J
 
-QUAT_TOL = 1e-3
+OK = 0
+NONFINITE = -1
+BAD_QUATERNION = -2
+
+
+@njit(cache=True, inline="always")
+def finite(x):
+    """True when every entry of the 1-D array ``x`` is finite."""
+    for k in range(x.shape[0]):
+        if not np.isfinite(x[k]):
+            return False
+    return True
 
 
 def _as_float(name: str, x) -> np.ndarray:
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
     try:
-        a = np.asarray(x, dtype=np.float64)
+        return np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
         raise ValueError(f"{name}: expected an array of numbers, got {type(x).__name__}") from None
-    return a
 
 
-def states(model, check_finite: bool = True, **arrays):
-    """Validate and flatten state arrays.
+def states(model, **arrays):
+    """Check shapes and bring the state arrays to the kernels' layout.
 
     ``arrays`` maps argument names (``q`` has length nq, every other one nv) to array-likes.
-    Returns ``(batch_shape, flat)`` where ``flat[name]`` is C-contiguous of shape
-    ``(B, n)`` with ``B = prod(batch_shape)``.
+    Returns ``(batch_shape, out)``: for a single state (``batch_shape == ()``) ``out[name]``
+    is the 1-D array itself, otherwise C-contiguous of shape ``(B, n)``,
+    ``B = prod(batch_shape)``.
     """
-    checked = {}
+    out = {}
+    single = True
     for name, x in arrays.items():
         a = _as_float(name, x)
         n = model.nq if name == "q" else model.nv
         if a.ndim == 0 or a.shape[-1] != n:
             raise ValueError(f"{name}: expected shape (..., {n}), got {a.shape}")
-        if check_finite and not np.isfinite(a).all():
-            bad = np.argwhere(~np.isfinite(a))[0].tolist()
-            raise ValueError(f"{name}: contains NaN or Inf (first at index {tuple(bad)}); "
-                             "pass check_finite=False to skip this check")
-        checked[name] = a
+        single = single and a.ndim == 1
+        out[name] = a
+    if single:
+        for name, a in out.items():
+            if not a.flags.c_contiguous:
+                out[name] = np.ascontiguousarray(a)
+        return (), out
     try:
-        batch = np.broadcast_shapes(*(a.shape[:-1] for a in checked.values()))
+        batch = np.broadcast_shapes(*(a.shape[:-1] for a in out.values()))
     except ValueError:
-        shapes = {k: a.shape for k, a in checked.items()}
+        shapes = {k: a.shape for k, a in out.items()}
         raise ValueError(f"leading (batch) dimensions do not broadcast: {shapes}") from None
-    B = int(np.prod(batch)) if batch else 1
-    flat = {}
-    for name, a in checked.items():
+    B = int(np.prod(batch))
+    for name, a in out.items():
         if a.shape[:-1] != batch:
             a = np.broadcast_to(a, batch + a.shape[-1:])
-        flat[name] = np.ascontiguousarray(a.reshape(B, a.shape[-1]))
-    if "q" in flat and model.floating_base:
-        flat["q"] = _normalized_quaternions(model, flat["q"])
-    return batch, flat
-
-
-def _normalized_quaternions(model, q: np.ndarray) -> np.ndarray:
-    copied = False
-    for i in np.flatnonzero(model.joint_type == J.FREE):
-        k = model.idx_q[i] + 3
-        n = np.sqrt(np.einsum("bi,bi->b", q[:, k:k + 4], q[:, k:k + 4]))
-        if np.any(np.abs(n - 1.0) > QUAT_TOL):
-            worst = float(n[np.argmax(np.abs(n - 1.0))])
-            raise ValueError(
-                f"q: quaternion of free joint {model.body_joint_names[i]!r} (q[{k}:{k + 4}]) has norm "
-                f"{worst:.6g}, not 1 (tolerance {QUAT_TOL}); normalise it"
-            )
-        if np.any(n != 1.0):
-            if not copied:
-                q, copied = q.copy(), True
-            q[:, k:k + 4] /= n[:, None]
-    return q
+        out[name] = np.ascontiguousarray(a.reshape(B, a.shape[-1]))
+    return batch, out
 
 
 def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, int]:
-    """External wrenches ``(..., nbodies, 6)`` ``[force, torque]`` -> ``(B or 1, nb, 6)``.
+    """External wrenches ``(..., nbodies, 6)`` ``[force, torque]`` for the kernels.
 
-    ``frame`` is where they are expressed: ``"local"`` (body frame, torque about the body
-    origin), ``"world"`` (world axes, torque about the world origin) or
-    ``"local_world_aligned"`` (world axes, torque about the body origin).
+    Returns ``(F, code)``: ``F`` is (nb, 6) for a single state, else (B or 1, nb, 6);
+    ``code`` is -1 without wrenches, else the frame they are expressed in: 0 ``"local"``
+    (body frame, torque about the body origin), 1 ``"world"`` (world axes, torque about the
+    world origin), 2 ``"local_world_aligned"`` (world axes, torque about the body origin).
     """
     codes = {"local": 0, "world": 1, "local_world_aligned": 2}
     if frame not in codes:
         raise ValueError(f"f_ext_frame must be one of {sorted(codes)}, got {frame!r}")
     nb = model.nbodies
+    zero = model._kernel["zero_wrench"]
     if f_ext is None:
-        return np.zeros((1, nb, 6)), -1
+        return (zero if batch == () else zero[None]), -1
     f = _as_float("f_ext", f_ext)
     if f.ndim < 2 or f.shape[-2:] != (nb, 6):
         raise ValueError(f"f_ext: expected shape (..., {nb}, 6), got {f.shape}")
     if not np.isfinite(f).all():
         raise ValueError("f_ext: contains NaN or Inf")
-    try:
-        full = np.broadcast_shapes(batch, f.shape[:-2])
-    except ValueError:
-        raise ValueError(f"f_ext: batch shape {f.shape[:-2]} does not broadcast with {batch}") from None
-    if full != batch:
-        raise ValueError(f"f_ext: batch shape {f.shape[:-2]} would enlarge the state batch {batch}")
     if f.shape[:-2] != batch:
+        try:
+            full = np.broadcast_shapes(batch, f.shape[:-2])
+        except ValueError:
+            full = None
+        if full != batch:
+            raise ValueError(f"f_ext: batch shape {f.shape[:-2]} does not match the states' {batch}")
         f = np.broadcast_to(f, batch + (nb, 6))
-    B = int(np.prod(batch)) if batch else 1
-    return np.ascontiguousarray(f.reshape(B, nb, 6)), codes[frame]
+    if batch == ():
+        return np.ascontiguousarray(f), codes[frame]
+    return np.ascontiguousarray(f.reshape(-1, nb, 6)), codes[frame]
 
 
 def chunks(B: int) -> int:
-    """Number of parallel chunks for a batch of ``B`` states (0 selects the serial path)."""
-    return 0 if B <= 1 else min(B, numba.get_num_threads())
+    """Number of parallel chunks for a batch of ``B`` states."""
+    return max(1, min(B, numba.get_num_threads()))
 
 
 def unflatten(out: np.ndarray, batch: tuple) -> np.ndarray:
-    return out.reshape(batch + out.shape[1:])
+    return out if batch == () else out.reshape(batch + out.shape[1:])
+
+
+def raise_for_status(model, status, arrays: dict, what: str) -> int:
+    """Raise the ``ValueError`` a kernel status stands for; return the failing body + 1 (or 0).
+
+    ``status`` is an int (single state) or an int array (batch); ``arrays`` are the inputs as
+    given to the kernel, used to say where the problem is.
+    """
+    if np.ndim(status) == 0:
+        code = int(status)
+    else:
+        bad = np.flatnonzero(status)
+        if bad.size == 0:
+            return 0
+        code = int(status[bad[0]])
+    if code == OK:
+        return 0
+    if code == NONFINITE:
+        for name, a in arrays.items():
+            idx = np.argwhere(~np.isfinite(a))
+            if idx.size:
+                raise ValueError(f"{what}: {name} contains NaN or Inf (first at index {tuple(idx[0].tolist())}); "
+                                 "pass check_finite=False to skip this check")
+        raise AssertionError("kernel reported a non-finite input that is not there")
+    if code == BAD_QUATERNION:
+        q = arrays["q"]
+        for i in np.flatnonzero(model.joint_type == J.FREE):
+            k = model.idx_q[i] + 3
+            n = np.linalg.norm(q[..., k:k + 4], axis=-1)
+            if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
+                worst = float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))])
+                raise ValueError(
+                    f"{what}: q: quaternion of free joint {model.body_joint_names[i]!r} (q[{k}:{k + 4}]) has norm "
+                    f"{worst:.6g}, not 1 (tolerance {J.QUAT_TOL}); normalise it"
+                )
+        raise AssertionError("kernel reported a bad quaternion that is not there")
+    return code

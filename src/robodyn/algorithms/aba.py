@@ -26,6 +26,7 @@ from ..joints import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
                        matvec6, motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
 from .kinematics import placements, world_placements
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
@@ -77,13 +78,17 @@ def invert_block(Dinv, iv, n, G, tol):
 
 
 @njit(cache=True)
-def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
-    """Forward dynamics of one state into ``qdd`` (nv,). Returns 0, or ``i + 1`` when the
-    articulated inertia of body ``i`` is singular."""
+def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
+    """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
+    ``i + 1`` when the articulated inertia of body ``i`` is singular."""
     (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
      X, tmp, UD, G, t1, t2, Ia) = ws
     nb = ints.shape[0]
-    placements(ints, body, q, liR, lip, Rj, pj)
+    if check and not (finite(q) and finite(v) and finite(tau)):
+        return NONFINITE
+    if not placements(ints, body, q, liR, lip, Rj, pj):
+        return BAD_QUATERNION
+    eps = params[3]
     if fcode > 0:
         world_placements(ints, liR, lip, oR, op)
     # Pass 1
@@ -96,7 +101,7 @@ def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
         t1[:] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
-                t1[r] += S[k, r] * v[k]
+                t1[r] += dofs[k, r] * v[k]
         for r in range(6):
             vel[i, r] += t1[r]
         motion_cross(vel[i], t1, c[i])
@@ -115,16 +120,16 @@ def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
         for r in range(6):
             scale += abs(IA[i, r, r])
         for k in range(iv, iv + n):
-            matvec6(IA[i], S[k], U[k])
+            matvec6(IA[i], dofs[k, :6], U[k])
             s = 0.0
             for r in range(6):
-                s += S[k, r] * pA[i, r]
-            u[k] = tau[k] - s - friction_torque(dof, eps, v, k)
+                s += dofs[k, r] * pA[i, r]
+            u[k] = tau[k] - s - friction_torque(dofs, eps, v, k)
             for j in range(iv, iv + n):
                 d = 0.0
                 for r in range(6):
-                    d += S[j, r] * U[k, r]
-                Dinv[j, k - iv] = d + (dof[k, 0] if j == k else 0.0)
+                    d += dofs[j, r] * U[k, r]
+                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
         if not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
             return i + 1
         if par >= 0:
@@ -154,7 +159,7 @@ def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
     # Pass 3
     for k in range(6):
         t2[k] = 0.0
-    t2[0], t2[1], t2[2] = -grav[0], -grav[1], -grav[2]
+    t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if par >= 0:
@@ -175,23 +180,24 @@ def aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, ws):
             qdd[j] = s
         for k in range(iv, iv + n):
             for r in range(6):
-                acc[i, r] += S[k, r] * qdd[k]
-    return 0
+                acc[i, r] += dofs[k, r] * qdd[k]
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _aba_batch(ints, body, S, dof, grav, eps, Q, V, T, F, fcode, QDD, status, nchunk):
+def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = aba_one(ints, body, S, dof, grav, eps, Q[s], V[s], T[s], F[s if F.shape[0] > 1 else 0],
-                                fcode, QDD[s], ws)
+            status[s] = aba_one(ints, body, dofs, params, Q[s], V[s], T[s], F[s if F.shape[0] > 1 else 0],
+                                fcode, check, QDD[s], ws)
 
 
 @njit(cache=True)
-def _aba_single(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd):
-    return aba_one(ints, body, S, dof, grav, eps, q, v, tau, fext, fcode, qdd, workspace(ints.shape[0], S.shape[0]))
+def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
+    return aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd,
+                   workspace(ints.shape[0], dofs.shape[0]))
 
 
 def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
@@ -210,21 +216,19 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
     leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
     """
-    batch, flat = _inputs.states(model, check_finite, q=q, v=v, tau=tau)
+    batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    ints, body, S, _ = model._kernel
-    dof = model._dof(friction, armature)
-    Q, V, T = flat["q"], flat["v"], flat["tau"]
-    B = Q.shape[0]
-    QDD = np.empty((B, model.nv))
-    eps = model.coulomb_smoothing
-    nchunk = _inputs.chunks(B)
-    if nchunk:
-        status = np.zeros(B, dtype=np.int64)
-        _aba_batch(ints, body, S, dof, model.gravity, eps, Q, V, T, F, fcode, QDD, status, nchunk)
-        bad = int(status.max())
+    k = model._kernel
+    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    if batch == ():
+        qdd = np.empty(model.nv)
+        status = _aba_single(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd)
     else:
-        bad = _aba_single(ints, body, S, dof, model.gravity, eps, Q[0], V[0], T[0], F[0], fcode, QDD[0])
+        B = x["q"].shape[0]
+        qdd, status = np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
+        _aba_batch(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd, status,
+                   _inputs.chunks(B))
+    bad = _inputs.raise_for_status(model, status, x, "aba")
     if bad:
         i = bad - 1
         raise ValueError(
@@ -232,4 +236,4 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
             f"{model.body_joint_names[i]!r}) is singular, so the forward dynamics is undefined; "
             "give the bodies beyond it mass and inertia about the joint axis (or armature)"
         )
-    return _inputs.unflatten(QDD, batch)
+    return _inputs.unflatten(qdd, batch)

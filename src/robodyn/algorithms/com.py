@@ -15,7 +15,8 @@ from numba import njit, prange
 
 from . import _inputs
 from .crba import world_inertias
-from .kinematics import placements, world_motion_subspace, world_placements
+from ._inputs import OK
+from .kinematics import poses_checked, world_motion_subspace
 
 
 @njit(cache=True)
@@ -25,14 +26,15 @@ def workspace(nb, nv):
 
 
 @njit(cache=True)
-def com_one(ints, body, S, q, c, Jc, ws):
+def com_one(ints, body, dofs, q, check, c, Jc, ws):
     """Centre of mass ``c`` (3,) and, if ``Jc`` has columns, its Jacobian (3, nv)."""
     liR, lip, oR, op, Rj, pj, oS, Ic = ws
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
+    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
     world_inertias(ints, body, oR, op, Ic)
     if Jc.shape[1] > 0:
-        world_motion_subspace(ints, S, oR, op, oS)
+        world_motion_subspace(ints, dofs, oR, op, oS)
     for i in range(ints.shape[0] - 1, -1, -1):
         if Jc.shape[1] > 0:
             m, hx, hy, hz = Ic[i, 0], Ic[i, 1], Ic[i, 2], Ic[i, 3]
@@ -56,45 +58,39 @@ def com_one(ints, body, S, q, c, Jc, ws):
         c[r] /= mass
         for k in range(Jc.shape[1]):
             Jc[r, k] /= mass
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _com_batch(ints, body, S, Q, C, JC, nchunk):
+def _com_batch(ints, body, dofs, Q, check, C, JC, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            com_one(ints, body, S, Q[s], C[s], JC[s], ws)
+            status[s] = com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
 
 
-@njit(cache=True)
-def _com_single(ints, body, S, q, c, Jc):
-    com_one(ints, body, S, q, c, Jc, workspace(ints.shape[0], S.shape[0]))
-
-
-def _run(model, q, check_finite, with_jacobian):
+def _run(model, q, check_finite, with_jacobian, what):
     if model.total_mass <= 0:
-        raise ValueError("the model has no mass: its centre of mass is undefined")
-    batch, flat = _inputs.states(model, check_finite, q=q)
-    ints, body, S, _ = model._kernel
-    Q = flat["q"]
+        raise ValueError(f"{what}: the model has no mass: its centre of mass is undefined")
+    batch, x = _inputs.states(model, q=q)
+    k = model._kernel
+    Q = x["q"].reshape(-1, model.nq)
     B = Q.shape[0]
     C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
-    nchunk = _inputs.chunks(B)
-    if nchunk:
-        _com_batch(ints, body, S, Q, C, JC, nchunk)
-    else:
-        _com_single(ints, body, S, Q[0], C[0], JC[0])
+    status = np.empty(B, dtype=np.int64)
+    _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
     return batch, C, JC
 
 
 def center_of_mass(model, q, *, check_finite: bool = True) -> np.ndarray:
     """World position of the centre of mass of all bodies: (..., 3) for q (..., nq)."""
-    batch, C, _ = _run(model, q, check_finite, False)
-    return _inputs.unflatten(C, batch)
+    batch, C, _ = _run(model, q, check_finite, False, "center_of_mass")
+    return C[0] if batch == () else C.reshape(batch + (3,))
 
 
 def com_jacobian(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Jacobian of the centre of mass, (..., 3, nv): ``J_com v`` is its world-frame velocity."""
-    batch, _, JC = _run(model, q, check_finite, True)
-    return _inputs.unflatten(JC, batch)
+    batch, _, JC = _run(model, q, check_finite, True, "com_jacobian")
+    return JC[0] if batch == () else JC.reshape(batch + JC.shape[1:])

@@ -27,7 +27,8 @@ from numba import njit, prange
 from ..spatial import dot6, inertia_matrix, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
-from .kinematics import placements, world_motion_subspace, world_placements
+from ._inputs import NONFINITE, OK, finite
+from .kinematics import poses_checked, world_motion_subspace
 
 
 @njit(cache=True)
@@ -62,12 +63,15 @@ def body_B(theta, V, Imat, Vx, h, B):
 
 
 @njit(cache=True)
-def coriolis_one(ints, body, S, q, v, C, ws):
+def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, Imat, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
-    world_motion_subspace(ints, S, oR, op, oS)
+    if check and not finite(v):
+        return NONFINITE
+    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    world_motion_subspace(ints, dofs, oR, op, oS)
     world_inertias(ints, body, oR, op, Ic)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
@@ -103,32 +107,35 @@ def coriolis_one(ints, body, S, q, v, C, ws):
             for r in range(6):
                 for c in range(6):
                     Bc[par, r, c] += Bc[i, r, c]
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _coriolis_batch(ints, body, S, Q, V, CC, nchunk):
+def _coriolis_batch(ints, body, dofs, Q, V, check, CC, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            coriolis_one(ints, body, S, Q[s], V[s], CC[s], ws)
+            status[s] = coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
 
 
 @njit(cache=True)
-def _coriolis_single(ints, body, S, q, v, C):
-    coriolis_one(ints, body, S, q, v, C, workspace(ints.shape[0], S.shape[0]))
+def _coriolis_single(ints, body, dofs, q, v, check, C):
+    return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 
 
-def _run(model, Q, V):
-    ints, body, S, _ = model._kernel
-    B = Q.shape[0]
-    CC = np.empty((B, model.nv, model.nv))
-    nchunk = _inputs.chunks(B)
-    if nchunk:
-        _coriolis_batch(ints, body, S, Q, V, CC, nchunk)
+def _run(model, batch, x, check, what):
+    k = model._kernel
+    dofs, q, v = k["dofs"][(False, False)], x["q"], x["v"]
+    if batch == ():
+        C = np.empty((model.nv, model.nv))
+        status = _coriolis_single(k["ints"], k["body"], dofs, q, v, check, C)
     else:
-        _coriolis_single(ints, body, S, Q[0], V[0], CC[0])
-    return CC
+        B = q.shape[0]
+        C, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
+        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
+    return C
 
 
 def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
@@ -138,8 +145,8 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     ``Mdot - 2C`` is skew-symmetric and ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel
     symbols of :func:`christoffel_symbols`. Reference: Echeandia and Wensing (2021).
     """
-    batch, flat = _inputs.states(model, check_finite, q=q, v=v)
-    return _inputs.unflatten(_run(model, flat["q"], flat["v"]), batch)
+    batch, x = _inputs.states(model, q=q, v=v)
+    return _inputs.unflatten(_run(model, batch, x, check_finite, "coriolis_matrix"), batch)
 
 
 def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
@@ -152,9 +159,10 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     ``C(q, e_k)`` and satisfies ``C = Gamma v``, but it is not symmetric in ``j, k`` for the
     base directions.
     """
-    batch, flat = _inputs.states(model, check_finite, q=q)
+    batch, x = _inputs.states(model, q=q)
     nv = model.nv
-    Q = np.repeat(flat["q"], nv, axis=0)
-    V = np.tile(np.eye(nv), (flat["q"].shape[0], 1))
-    CC = _run(model, Q, V).reshape(-1, nv, nv, nv)  # (B, k, i, j)
-    return _inputs.unflatten(np.ascontiguousarray(CC.transpose(0, 2, 3, 1)), batch)
+    Q = np.repeat(x["q"].reshape(-1, model.nq), nv, axis=0)
+    V = np.tile(np.eye(nv), (Q.shape[0] // nv, 1))
+    CC = _run(model, (Q.shape[0],), {"q": Q, "v": V}, check_finite, "christoffel_symbols").reshape(-1, nv, nv, nv)
+    G = np.ascontiguousarray(CC.transpose(0, 2, 3, 1))  # (B, k, i, j) -> (B, i, j, k)
+    return G[0] if batch == () else G.reshape(batch + (nv, nv, nv))

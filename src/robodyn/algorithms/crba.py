@@ -18,7 +18,8 @@ from numba import njit, prange
 
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
-from .kinematics import placements, world_motion_subspace, world_placements
+from ._inputs import OK
+from .kinematics import poses_checked, world_motion_subspace
 
 
 @njit(cache=True)
@@ -35,11 +36,12 @@ def world_inertias(ints, body, oR, op, Ic):
 
 
 @njit(cache=True)
-def crba_one(ints, body, S, dof, q, M, ws):
+def crba_one(ints, body, dofs, q, check, M, ws):
     liR, lip, oR, op, Rj, pj, oS, Ic, F = ws
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
-    world_motion_subspace(ints, S, oR, op, oS)
+    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    world_motion_subspace(ints, dofs, oR, op, oS)
     world_inertias(ints, body, oR, op, Ic)
     M[:, :] = 0.0
     for i in range(ints.shape[0] - 1, -1, -1):
@@ -53,24 +55,25 @@ def crba_one(ints, body, S, dof, q, M, ws):
                     M[l, k] = val
                     M[k, l] = val
                 j = ints[j, 0]
-            M[k, k] += dof[k, 0]
+            M[k, k] += dofs[k, 6]
         if par >= 0:
             for r in range(10):
                 Ic[par, r] += Ic[i, r]
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _crba_batch(ints, body, S, dof, Q, MM, nchunk):
+def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            crba_one(ints, body, S, dof, Q[s], MM[s], ws)
+            status[s] = crba_one(ints, body, dofs, Q[s], check, MM[s], ws)
 
 
 @njit(cache=True)
-def _crba_single(ints, body, S, dof, q, M):
-    crba_one(ints, body, S, dof, q, M, workspace(ints.shape[0], S.shape[0]))
+def _crba_single(ints, body, dofs, q, check, M):
+    return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
 def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
@@ -82,15 +85,15 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.nd
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
-    batch, flat = _inputs.states(model, check_finite, q=q)
-    ints, body, S, _ = model._kernel
-    dof = model._dof(False, armature)
-    Q = flat["q"]
-    B = Q.shape[0]
-    MM = np.empty((B, model.nv, model.nv))
-    nchunk = _inputs.chunks(B)
-    if nchunk:
-        _crba_batch(ints, body, S, dof, Q, MM, nchunk)
+    batch, x = _inputs.states(model, q=q)
+    k = model._kernel
+    dofs, q = k["dofs"][(False, bool(armature))], x["q"]
+    if batch == ():
+        M = np.empty((model.nv, model.nv))
+        status = _crba_single(k["ints"], k["body"], dofs, q, check_finite, M)
     else:
-        _crba_single(ints, body, S, dof, Q[0], MM[0])
-    return _inputs.unflatten(MM, batch)
+        B = q.shape[0]
+        M, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
+        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, "crba")
+    return _inputs.unflatten(M, batch)

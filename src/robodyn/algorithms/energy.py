@@ -14,7 +14,8 @@ from numba import njit, prange
 
 from ..spatial import dot6, inertia_mul
 from . import _inputs
-from .kinematics import placements, world_placements
+from ._inputs import NONFINITE, OK, finite
+from .kinematics import poses_checked
 from .rnea import motion_pass
 
 
@@ -26,14 +27,17 @@ def workspace(nb, nv):
 
 
 @njit(cache=True)
-def energy_one(ints, body, S, grav, q, v, out, ws):
+def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic energy (when ``v`` has entries), ``out[1]`` potential energy."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
+    if check and not finite(v):
+        return NONFINITE
+    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
     T, U = 0.0, 0.0
     if v.shape[0] > 0:
-        motion_pass(ints, S, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
+        motion_pass(ints, dofs, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
     for i in range(ints.shape[0]):
         theta = body[i, 15:25]
         if v.shape[0] > 0:
@@ -44,43 +48,38 @@ def energy_one(ints, body, S, grav, q, v, out, ws):
             U -= grav[r] * mc
     out[0] = T
     out[1] = U
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _energy_batch(ints, body, S, grav, Q, V, OUT, nchunk):
+def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            energy_one(ints, body, S, grav, Q[s], V[s if V.shape[0] > 1 else 0], OUT[s], ws)
+            status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
 
 
-@njit(cache=True)
-def _energy_single(ints, body, S, grav, q, v, out):
-    energy_one(ints, body, S, grav, q, v, out, workspace(ints.shape[0], S.shape[0]))
-
-
-def _run(model, check_finite, **arrays):
-    batch, flat = _inputs.states(model, check_finite, **arrays)
-    ints, body, S, _ = model._kernel
-    Q = flat["q"]
-    V = flat.get("v", np.zeros((1, 0)))
-    OUT = np.empty((Q.shape[0], 2))
-    nchunk = _inputs.chunks(Q.shape[0])
-    if nchunk:
-        _energy_batch(ints, body, S, model.gravity, Q, V, OUT, nchunk)
-    else:
-        _energy_single(ints, body, S, model.gravity, Q[0], V[0], OUT[0])
+def _run(model, check_finite, what, **arrays):
+    batch, x = _inputs.states(model, **arrays)
+    k = model._kernel
+    Q = x["q"].reshape(-1, model.nq)
+    V = x["v"].reshape(-1, model.nv) if "v" in x else np.zeros((1, 0))
+    B = Q.shape[0]
+    OUT, status = np.empty((B, 2)), np.empty(B, dtype=np.int64)
+    _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,
+                  _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
     return batch, OUT
 
 
 def kinetic_energy(model, q, v, *, check_finite: bool = True):
     """Kinetic energy ``v^T M(q) v / 2`` of the rigid bodies: (...,) for q (..., nq), v (..., nv)."""
-    batch, OUT = _run(model, check_finite, q=q, v=v)
+    batch, OUT = _run(model, check_finite, "kinetic_energy", q=q, v=v)
     return OUT[:, 0].reshape(batch)[()]
 
 
 def potential_energy(model, q, *, check_finite: bool = True):
     """Gravitational potential energy ``-sum_i m_i g . c_i``: (...,) for q (..., nq)."""
-    batch, OUT = _run(model, check_finite, q=q)
+    batch, OUT = _run(model, check_finite, "potential_energy", q=q)
     return OUT[:, 1].reshape(batch)[()]

@@ -21,7 +21,8 @@ from numba import njit, prange
 
 from ..spatial import motion_act
 from . import _inputs
-from .kinematics import placements, world_placements
+from ._inputs import NONFINITE, OK, finite
+from .kinematics import poses_checked
 from .rnea import motion_pass
 
 FRAMES = ("world", "local", "local_world_aligned")
@@ -35,50 +36,51 @@ def workspace(nb, nv):
 
 
 @njit(cache=True)
-def jacobian_one(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b, ws):
+def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws):
     """World Jacobian ``J`` (6, nv) of body ``b``, its pose, and (when ``v`` has entries) the
     body-frame velocity and acceleration of ``b`` at ``qdd = 0`` without gravity."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
+    if check and not finite(v):
+        return NONFINITE
+    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
     J[:, :] = 0.0
     j = b
     while j >= 0:
         for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
-            motion_act(oR[j], op[j], S[k], J[:, k])
+            motion_act(oR[j], op[j], dofs[k, :6], J[:, k])
         j = ints[j, 0]
     oRb[:, :] = oR[b]
     opb[:] = op[b]
     if v.shape[0] > 0:
-        motion_pass(ints, S, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
+        motion_pass(ints, dofs, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
         acc_b[:] = acc[b]
         vel_b[:] = vel[b]
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _jacobian_batch(ints, body, S, Q, V, b, JJ, OR, OP, ACC, VEL, nchunk):
+def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], S.shape[0])
+        ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            jacobian_one(ints, body, S, Q[s], V[s], b, JJ[s], OR[s], OP[s], ACC[s], VEL[s], ws)
+            status[s] = jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s],
+                                     OP[s], ACC[s], VEL[s], ws)
 
 
-@njit(cache=True)
-def _jacobian_single(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b):
-    jacobian_one(ints, body, S, q, v, b, J, oRb, opb, acc_b, vel_b, workspace(ints.shape[0], S.shape[0]))
-
-
-def _run(model, Q, V, b):
-    ints, body, S, _ = model._kernel
-    B = Q.shape[0]
+def _run(model, x, b, check, what):
+    """Flat-batch results ``(J, oR_b, op_b, acc_b, vel_b)`` for the states ``x``."""
+    k = model._kernel
+    q = x["q"].reshape(-1, model.nq)
+    v = x["v"].reshape(-1, model.nv) if "v" in x else np.zeros((1, 0))
+    B = q.shape[0]
     JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
-    ACC, VEL = np.empty((B, 6)), np.empty((B, 6))
-    nchunk = _inputs.chunks(B)
-    if nchunk:
-        _jacobian_batch(ints, body, S, Q, V, b, JJ, OR, OP, ACC, VEL, nchunk)
-    else:
-        _jacobian_single(ints, body, S, Q[0], V[0], b, JJ[0], OR[0], OP[0], ACC[0], VEL[0])
+    ACC, VEL, status = np.empty((B, 6)), np.empty((B, 6)), np.empty(B, dtype=np.int64)
+    _jacobian_batch(k["ints"], k["body"], k["dofs"][(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL, status,
+                    _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
     return JJ, OR, OP, ACC, VEL
 
 
@@ -107,16 +109,15 @@ def jacobian(model, q, body, frame: str = "world", *, check_finite: bool = True)
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
     b, Rbf, pbf = _frame(model, body)
-    batch, flat = _inputs.states(model, check_finite, q=q)
-    Q = flat["q"]
-    JJ, OR, OP, _, _ = _run(model, Q, np.zeros((Q.shape[0], 0)), b)
+    batch, x = _inputs.states(model, q=q)
+    JJ, OR, OP, _, _ = _run(model, x, b, check_finite, "jacobian")
     if frame != "world":
         Rf, pf = OR @ Rbf, OP + OR @ pbf
         lin = JJ[:, :3] - _cross(pf, JJ[:, 3:])
         JJ = np.concatenate([lin, JJ[:, 3:]], axis=1)
         if frame == "local":
             JJ = _rotate_T(Rf, JJ)
-    return _inputs.unflatten(JJ, batch)
+    return JJ[0] if batch == () else JJ.reshape(batch + JJ.shape[1:])
 
 
 def _rotate_T(R, X):
@@ -134,8 +135,8 @@ def jacobian_dot_times_v(model, q, v, body, frame: str = "world", *, check_finit
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
     b, Rbf, pbf = _frame(model, body)
-    batch, flat = _inputs.states(model, check_finite, q=q, v=v)
-    _, OR, OP, ACC, VEL = _run(model, flat["q"], flat["v"], b)
+    batch, x = _inputs.states(model, q=q, v=v)
+    _, OR, OP, ACC, VEL = _run(model, x, b, check_finite, "jacobian_dot_times_v")
     # spatial acceleration and velocity in the frame's own coordinates (frame rigid on body b)
     acc_f = _rotate_T(np.broadcast_to(Rbf, OR.shape), _shift(ACC, pbf))
     if frame == "local":
@@ -148,7 +149,7 @@ def jacobian_dot_times_v(model, q, v, body, frame: str = "world", *, check_finit
         Rf = OR @ Rbf
         classical = acc_f[:, :3] + np.cross(vel_f[:, 3:], vel_f[:, :3])
         out = np.concatenate([np.einsum("bij,bj->bi", Rf, classical), np.einsum("bij,bj->bi", Rf, acc_f[:, 3:])], axis=1)
-    return _inputs.unflatten(out, batch)
+    return out[0] if batch == () else out.reshape(batch + (6,))
 
 
 def _shift(m, p):

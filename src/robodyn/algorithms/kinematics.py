@@ -16,18 +16,24 @@ from numba import njit, prange
 from ..joints import joint_transform
 from ..spatial import compose, motion_act
 from . import _inputs
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
 
 
 @njit(cache=True, inline="always")
 def placements(ints, body, q, liR, lip, Rj, pj):
-    """``liR[i], lip[i]``: placement of body ``i`` in its parent at configuration ``q``."""
+    """``liR[i], lip[i]``: placement of body ``i`` in its parent at configuration ``q``.
+
+    Returns False when a free joint's quaternion is not of unit norm (see ``joints``).
+    """
     for i in range(ints.shape[0]):
-        joint_transform(ints[i, 1], body[i, 12:15], q, ints[i, 2], Rj, pj)
+        if not joint_transform(ints[i, 1], body[i, 12:15], q, ints[i, 2], Rj, pj):
+            return False
         for r in range(3):
             lip[i, r] = body[i, 9 + r] + body[i, 3 * r] * pj[0] + body[i, 3 * r + 1] * pj[1] + body[i, 3 * r + 2] * pj[2]
             for c in range(3):
                 liR[i, r, c] = (body[i, 3 * r] * Rj[0, c] + body[i, 3 * r + 1] * Rj[1, c]
                                 + body[i, 3 * r + 2] * Rj[2, c])
+    return True
 
 
 @njit(cache=True, inline="always")
@@ -43,40 +49,57 @@ def world_placements(ints, liR, lip, oR, op):
 
 
 @njit(cache=True, inline="always")
-def world_motion_subspace(ints, S, oR, op, oS):
+def world_motion_subspace(ints, dofs, oR, op, oS):
     """``oS[k]``: motion subspace column ``k`` in world coordinates (``J`` of its body)."""
     for i in range(ints.shape[0]):
         for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
-            motion_act(oR[i], op[i], S[k], oS[k])
+            motion_act(oR[i], op[i], dofs[k, :6], oS[k])
+
+
+@njit(cache=True, inline="always")
+def poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op):
+    """Local and world placements of every body, with the input checks; returns a status."""
+    if check and not finite(q):
+        return NONFINITE
+    if not placements(ints, body, q, liR, lip, Rj, pj):
+        return BAD_QUATERNION
+    world_placements(ints, liR, lip, oR, op)
+    return OK
 
 
 @njit(cache=True)
-def _fk_one(ints, body, q, oR, op, liR, lip, Rj, pj):
-    placements(ints, body, q, liR, lip, Rj, pj)
-    world_placements(ints, liR, lip, oR, op)
+def workspace(nb):
+    return np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3)
+
+
+@njit(cache=True)
+def _fk_single(ints, body, q, oR, op, check):
+    liR, lip, Rj, pj = workspace(ints.shape[0])
+    return poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
 
 
 @njit(cache=True, parallel=True)
-def _fk_batch(ints, body, Q, OR, OP, nchunk):
-    B, nb = Q.shape[0], ints.shape[0]
+def _fk_batch(ints, body, Q, OR, OP, check, status, nchunk):
+    B = Q.shape[0]
     for c in prange(nchunk):
-        liR, lip = np.empty((nb, 3, 3)), np.empty((nb, 3))
-        Rj, pj = np.empty((3, 3)), np.empty(3)
+        liR, lip, Rj, pj = workspace(ints.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            _fk_one(ints, body, Q[s], OR[s], OP[s], liR, lip, Rj, pj)
+            status[s] = poses_checked(ints, body, Q[s], check, liR, lip, Rj, pj, OR[s], OP[s])
 
 
-def world_poses(model, Q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``(oR, op)`` of shapes ``(B, nb, 3, 3)``, ``(B, nb, 3)`` for flat states ``Q``."""
-    ints, body = model._kernel[0], model._kernel[1]
-    B, nb = Q.shape[0], model.nbodies
-    OR, OP = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3))
-    n = _inputs.chunks(B)
-    if n:
-        _fk_batch(ints, body, Q, OR, OP, n)
+def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """World rotations (..., nb, 3, 3) and positions (..., nb, 3) of every body, flat batch."""
+    ints, body = model._kernel["ints"], model._kernel["body"]
+    nb = model.nbodies
+    if batch == ():
+        oR, op = np.empty((nb, 3, 3)), np.empty((nb, 3))
+        status = _fk_single(ints, body, q, oR, op, check)
     else:
-        _fk_one(ints, body, Q[0], OR[0], OP[0], np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3))
-    return OR, OP
+        B = q.shape[0]
+        oR, op, status = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3)), np.empty(B, dtype=np.int64)
+        _fk_batch(ints, body, q, oR, op, check, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, {"q": q}, what)
+    return oR, op
 
 
 def _homogeneous(R: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -87,30 +110,30 @@ def _homogeneous(R: np.ndarray, p: np.ndarray) -> np.ndarray:
     return T
 
 
-def forward_kinematics(model, q, check_finite: bool = True) -> np.ndarray:
+def forward_kinematics(model, q, *, check_finite: bool = True) -> np.ndarray:
     """World pose of every body.
 
-    q: (..., nq). Returns (..., nbodies, 4, 4): ``T[..., i]`` maps body-``i`` coordinates to
-    world coordinates (rotation block and origin position).
+    q: (..., nq). Returns (..., nbodies, 4, 4): ``T[..., i, :, :]`` maps body-``i``
+    coordinates to world coordinates (rotation block and origin position).
     """
-    batch, flat = _inputs.states(model, check_finite, q=q)
-    OR, OP = world_poses(model, flat["q"])
-    return _inputs.unflatten(_homogeneous(OR, OP), batch)
+    batch, x = _inputs.states(model, q=q)
+    oR, op = world_poses(model, x["q"], batch, check_finite, "forward_kinematics")
+    return _inputs.unflatten(_homogeneous(oR, op), batch)
 
 
-def frame_placement(model, OR: np.ndarray, OP: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """World rotation (B, 3, 3) and position (B, 3) of a link or frame from body poses."""
+def frame_placement(model, oR: np.ndarray, op: np.ndarray, name: str) -> tuple[np.ndarray, np.ndarray]:
+    """World rotation (..., 3, 3) and position (..., 3) of a link or frame from body poses."""
     b, R, p = model.frame_index(name)
     if b < 0:
-        B = OR.shape[0]
-        return np.broadcast_to(R, (B, 3, 3)).copy(), np.broadcast_to(p, (B, 3)).copy()
-    oR, op = OR[:, b], OP[:, b]
-    return oR @ R, op + oR @ p
+        lead = oR.shape[:-3]
+        return np.broadcast_to(R, lead + (3, 3)).copy(), np.broadcast_to(p, lead + (3,)).copy()
+    Rb, pb = oR[..., b, :, :], op[..., b, :]
+    return Rb @ R, pb + Rb @ p
 
 
-def frame_pose(model, q, name: str, check_finite: bool = True) -> np.ndarray:
+def frame_pose(model, q, name: str, *, check_finite: bool = True) -> np.ndarray:
     """World pose (..., 4, 4) of a link or frame (a body, or a link merged into one)."""
-    batch, flat = _inputs.states(model, check_finite, q=q)
-    OR, OP = world_poses(model, flat["q"])
-    R, p = frame_placement(model, OR, OP, name)
+    batch, x = _inputs.states(model, q=q)
+    oR, op = world_poses(model, x["q"], batch, check_finite, "frame_pose")
+    R, p = frame_placement(model, oR, op, name)
     return _inputs.unflatten(_homogeneous(R, p), batch)

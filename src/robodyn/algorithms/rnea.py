@@ -22,6 +22,7 @@ from numba import njit, prange
 from ..joints import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
 from .kinematics import placements, world_placements
 
 
@@ -33,7 +34,7 @@ def workspace(nb):
 
 
 @njit(cache=True, inline="always")
-def motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
+def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
     """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the
     base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
     for k in range(6):
@@ -47,11 +48,12 @@ def motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
         else:
             vel[i, :] = 0.0
             motion_act_inv(liR[i], lip[i], a0, acc[i])
-        vJ[:] = 0.0
+        for r in range(6):
+            vJ[r] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
-                vJ[r] += S[k, r] * v[k]
-                acc[i, r] += S[k, r] * a[k]
+                vJ[r] += dofs[k, r] * v[k]
+                acc[i, r] += dofs[k, r] * a[k]
         for r in range(6):
             vel[i, r] += vJ[r]
         motion_cross(vel[i], vJ, t1)
@@ -60,14 +62,20 @@ def motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
 
 
 @njit(cache=True)
-def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
-    """Inverse dynamics of one state into ``tau`` (nv,). ``fcode < 0``: no external wrench."""
+def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
+    """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
+
+    ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
+    """
     liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
     nb = ints.shape[0]
-    placements(ints, body, q, liR, lip, Rj, pj)
+    if check and not (finite(q) and finite(v) and finite(a)):
+        return NONFINITE
+    if not placements(ints, body, q, liR, lip, Rj, pj):
+        return BAD_QUATERNION
     if fcode > 0:
         world_placements(ints, liR, lip, oR, op)
-    motion_pass(ints, S, liR, lip, v, a, grav, vel, acc, vJ, t1, t2)
+    motion_pass(ints, dofs, liR, lip, v, a, params, vel, acc, vJ, t1, t2)
     for i in range(nb):
         theta = body[i, 15:25]
         inertia_mul(theta, acc[i], f[i])
@@ -80,45 +88,50 @@ def rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, ws):
             for r in range(6):
                 f[i, r] -= t1[r]
     # Pass 2: joint torques and forces transmitted to the parents
+    eps = params[3]
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         for k in range(iv, iv + n):
             s = 0.0
             for r in range(6):
-                s += S[k, r] * f[i, r]
-            tau[k] = s + dof[k, 0] * a[k] + friction_torque(dof, eps, v, k)
+                s += dofs[k, r] * f[i, r]
+            tau[k] = s + dofs[k, 6] * a[k] + friction_torque(dofs, eps, v, k)
         if par >= 0:
             force_act(liR[i], lip[i], f[i], t1)
             for r in range(6):
                 f[par, r] += t1[r]
+    return OK
 
 
 @njit(cache=True, parallel=True)
-def _rnea_batch(ints, body, S, dof, grav, eps, Q, V, A, F, fcode, TAU, nchunk):
+def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
         ws = workspace(ints.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            rnea_one(ints, body, S, dof, grav, eps, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0], fcode, TAU[s], ws)
+            status[s] = rnea_one(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0],
+                                 fcode, check, TAU[s], ws)
 
 
 @njit(cache=True)
-def _rnea_single(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau):
-    rnea_one(ints, body, S, dof, grav, eps, q, v, a, fext, fcode, tau, workspace(ints.shape[0]))
+def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
+    return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
 
 
-def run(model, Q, V, A, F, fcode, gravity, dof) -> np.ndarray:
-    """RNEA on flat batches (B, n); the other algorithms build on this entry point."""
-    ints, body, S, _ = model._kernel
-    B = Q.shape[0]
-    TAU = np.empty((B, model.nv))
-    nchunk = _inputs.chunks(B)
-    eps = model.coulomb_smoothing
-    if nchunk:
-        _rnea_batch(ints, body, S, dof, gravity, eps, Q, V, A, F, fcode, TAU, nchunk)
+def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea"):
+    """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``)."""
+    k = model._kernel
+    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][gravity]
+    q, v, a = x["q"], x["v"], x["a"]
+    if batch == ():
+        tau = np.empty(model.nv)
+        status = _rnea_single(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau)
     else:
-        _rnea_single(ints, body, S, dof, gravity, eps, Q[0], V[0], A[0], F[0], fcode, TAU[0])
-    return TAU
+        B = q.shape[0]
+        tau, status = np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
+        _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
+    return _inputs.unflatten(tau, batch)
 
 
 def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
@@ -145,7 +158,6 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     nonlinear_effects(q, v)``, ``rnea(q, v, a) == crba(q) a + nonlinear_effects(q, v)`` without
     friction. Reference: Featherstone, RBDA (2008), Table 5.1.
     """
-    batch, flat = _inputs.states(model, check_finite, q=q, v=v, a=a)
+    batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    TAU = run(model, flat["q"], flat["v"], flat["a"], F, fcode, model.gravity, model._dof(friction, armature))
-    return _inputs.unflatten(TAU, batch)
+    return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)

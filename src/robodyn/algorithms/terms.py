@@ -15,26 +15,27 @@ from . import _inputs
 from .rnea import run
 
 
-def _rnea_term(model, q, v, a, check_finite, gravity, armature=False) -> np.ndarray:
+def _rnea_term(model, q, v, a, check_finite, gravity, armature, what) -> np.ndarray:
     """``rnea`` without friction, with ``v``/``a`` replaced by zeros where ``None``."""
     arrays = {"q": q, **({"v": v} if v is not None else {}), **({"a": a} if a is not None else {})}
-    batch, flat = _inputs.states(model, check_finite, **arrays)
-    Z = np.zeros((flat["q"].shape[0], model.nv))
-    F = np.zeros((1, model.nbodies, 6))
-    TAU = run(model, flat["q"], flat.get("v", Z), flat.get("a", Z), F, -1, gravity, model._dof(False, armature))
-    return _inputs.unflatten(TAU, batch)
+    batch, x = _inputs.states(model, **arrays)
+    zeros = np.zeros(batch + (model.nv,)).reshape(-1, model.nv) if batch else np.zeros(model.nv)
+    x.setdefault("v", zeros)
+    x.setdefault("a", zeros)
+    F, fcode = _inputs.body_wrenches(model, None, batch, "local")
+    return run(model, batch, x, F, fcode, check_finite, gravity=gravity, friction=False, armature=armature, what=what)
 
 
 def gravity(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Generalised gravity ``g(q)`` (..., nv): the joint forces that hold the robot still."""
-    return _rnea_term(model, q, None, None, check_finite, model.gravity)
+    return _rnea_term(model, q, None, None, check_finite, True, False, "gravity")
 
 
 def nonlinear_effects(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """``C(q, v) v + g(q)`` (..., nv), the Coriolis, centrifugal and gravity forces."""
-    return _rnea_term(model, q, v, None, check_finite, model.gravity)
+    return _rnea_term(model, q, v, None, check_finite, True, False, "nonlinear_effects")
 
 
 def generalized_momentum(model, q, v, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Generalised momentum ``M(q) v`` (..., nv), O(n) (``armature`` as in :func:`robodyn.crba`)."""
-    return _rnea_term(model, q, None, v, check_finite, np.zeros(3), armature)
+    return _rnea_term(model, q, None, v, check_finite, False, armature, "generalized_momentum")
