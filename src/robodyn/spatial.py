@@ -285,40 +285,59 @@ def matTvec6(A, x, out):
 
 
 @njit(**_JIT)
-def motion_transform_matrix_inv(R, p, X):
-    """6 x 6 matrix of ``motion_act_inv`` (parent to child coordinates)."""
-    for r in range(3):
-        for c in range(3):
-            X[r, c] = R[c, r]
-            X[r + 3, c + 3] = R[c, r]
-            X[r + 3, c] = 0.0
-    # upper-right block -R^T [p]x, with the columns of [p]x: (0, p2, -p1), (-p2, 0, p0), (p1, -p0, 0)
-    for r in range(3):
-        X[r, 3] = -(R[1, r] * p[2] - R[2, r] * p[1])
-        X[r, 4] = -(R[2, r] * p[0] - R[0, r] * p[2])
-        X[r, 5] = -(R[0, r] * p[1] - R[1, r] * p[0])
+def congruence_to_parent(R, p, A, B, PB, out):
+    """``out += X^T A X`` for a symmetric 6 x 6 ``A`` (an articulated inertia in the child
+    frame), ``X`` the parent-to-child motion transform of ``(R, p)``.
 
-
-@njit(**_JIT)
-def congruence_to_parent(R, p, A, X, tmp, out):
-    """``out += X^T A X`` with ``X`` the parent-to-child motion transform of ``(R, p)``.
-
-    Expresses a child-frame articulated inertia ``A`` (6 x 6) in the parent frame and adds it.
-    ``X`` and ``tmp`` are 6 x 6 workspaces.
+    With ``A = [[A11, A12], [A12^T, A22]]``, ``Bij = R Aij R^T`` and ``P = [p]x``:
+    ``X^T A X = [[B11, B12 - B11 P], [., B22 + P B12 + (P B12)^T - P B11 P]]`` (symmetric).
+    ``B`` (3, 3, 3) and ``PB`` (3, 3) are workspaces.
     """
-    motion_transform_matrix_inv(R, p, X)
-    for r in range(6):
-        for c in range(6):
-            s = 0.0
-            for k in range(6):
-                s += A[r, k] * X[k, c]
-            tmp[r, c] = s
-    for r in range(6):
-        for c in range(6):
-            s = 0.0
-            for k in range(6):
-                s += X[k, r] * tmp[k, c]
-            out[r, c] += s
+    for blk in range(3):
+        o_r = 0 if blk < 2 else 3
+        o_c = 0 if blk == 0 else 3
+        # B[blk] = R A_blk R^T
+        for r in range(3):
+            for c in range(3):
+                s = 0.0
+                for k in range(3):
+                    t = A[o_r + k, o_c] * R[c, 0] + A[o_r + k, o_c + 1] * R[c, 1] + A[o_r + k, o_c + 2] * R[c, 2]
+                    s += R[r, k] * t
+                B[blk, r, c] = s
+    p0, p1, p2 = p[0], p[1], p[2]
+    # columns of B11 P: (B11 P)[:, c] = B11 [p]x e_c
+    for r in range(3):
+        b0, b1, b2 = B[0, r, 0], B[0, r, 1], B[0, r, 2]
+        # row r of B11 P = row r of B11 times [p]x
+        bp0 = b1 * p2 - b2 * p1
+        bp1 = b2 * p0 - b0 * p2
+        bp2 = b0 * p1 - b1 * p0
+        out[r, 3] += B[1, r, 0] - bp0
+        out[r, 4] += B[1, r, 1] - bp1
+        out[r, 5] += B[1, r, 2] - bp2
+        out[3, r] += B[1, r, 0] - bp0
+        out[4, r] += B[1, r, 1] - bp1
+        out[5, r] += B[1, r, 2] - bp2
+        for c in range(3):
+            out[r, c] += B[0, r, c]
+    # PB = P B12; then P B11 P
+    for c in range(3):
+        x0, x1, x2 = B[1, 0, c], B[1, 1, c], B[1, 2, c]
+        PB[0, c] = p1 * x2 - p2 * x1
+        PB[1, c] = p2 * x0 - p0 * x2
+        PB[2, c] = p0 * x1 - p1 * x0
+    for r in range(3):
+        # row r of (P B11): (P B11)[r, :] = (p x B11[:, c])_r
+        q0 = p1 * B[0, 2, 0] - p2 * B[0, 1, 0] if r == 0 else (p2 * B[0, 0, 0] - p0 * B[0, 2, 0] if r == 1 else p0 * B[0, 1, 0] - p1 * B[0, 0, 0])
+        q1 = p1 * B[0, 2, 1] - p2 * B[0, 1, 1] if r == 0 else (p2 * B[0, 0, 1] - p0 * B[0, 2, 1] if r == 1 else p0 * B[0, 1, 1] - p1 * B[0, 0, 1])
+        q2 = p1 * B[0, 2, 2] - p2 * B[0, 1, 2] if r == 0 else (p2 * B[0, 0, 2] - p0 * B[0, 2, 2] if r == 1 else p0 * B[0, 1, 2] - p1 * B[0, 0, 2])
+        # (P B11 P)[r, :] = row (q0, q1, q2) times [p]x
+        pbp0 = q1 * p2 - q2 * p1
+        pbp1 = q2 * p0 - q0 * p2
+        pbp2 = q0 * p1 - q1 * p0
+        out[3 + r, 3] += B[2, r, 0] + PB[r, 0] + PB[0, r] - pbp0
+        out[3 + r, 4] += B[2, r, 1] + PB[r, 1] + PB[1, r] - pbp1
+        out[3 + r, 5] += B[2, r, 2] + PB[r, 2] + PB[2, r] - pbp2
 
 
 @njit(**_JIT)

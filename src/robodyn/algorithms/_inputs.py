@@ -44,28 +44,35 @@ def _as_float(name: str, x) -> np.ndarray:
         raise ValueError(f"{name}: expected an array of numbers, got {type(x).__name__}") from None
 
 
+_F8 = np.dtype(np.float64)
+
+
 def states(model, **arrays):
     """Check shapes and bring the state arrays to the kernels' layout.
 
     ``arrays`` maps argument names (``q`` has length nq, every other one nv) to array-likes.
     Returns ``(batch_shape, out)``: for a single state (``batch_shape == ()``) ``out[name]``
-    is the 1-D array itself, otherwise C-contiguous of shape ``(B, n)``,
+    is a contiguous 1-D array, otherwise C-contiguous of shape ``(B, n)``,
     ``B = prod(batch_shape)``.
     """
+    nq, nv = model.nq, model.nv
+    for name, x in arrays.items():  # fast path: contiguous float64 vectors of the right size
+        if not (type(x) is np.ndarray and x.dtype is _F8 and x.shape == ((nq,) if name == "q" else (nv,))
+                and x.strides == (8,)):
+            break
+    else:
+        return (), arrays
     out = {}
     single = True
     for name, x in arrays.items():
         a = _as_float(name, x)
-        n = model.nq if name == "q" else model.nv
+        n = nq if name == "q" else nv
         if a.ndim == 0 or a.shape[-1] != n:
             raise ValueError(f"{name}: expected shape (..., {n}), got {a.shape}")
         single = single and a.ndim == 1
         out[name] = a
     if single:
-        for name, a in out.items():
-            if not a.flags.c_contiguous:
-                out[name] = np.ascontiguousarray(a)
-        return (), out
+        return (), {name: np.ascontiguousarray(a) for name, a in out.items()}
     try:
         batch = np.broadcast_shapes(*(a.shape[:-1] for a in out.values()))
     except ValueError:
@@ -79,6 +86,9 @@ def states(model, **arrays):
     return batch, out
 
 
+_WRENCH_FRAMES = {"local": 0, "world": 1, "local_world_aligned": 2}
+
+
 def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, int]:
     """External wrenches ``(..., nbodies, 6)`` ``[force, torque]`` for the kernels.
 
@@ -87,13 +97,13 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
     (body frame, torque about the body origin), 1 ``"world"`` (world axes, torque about the
     world origin), 2 ``"local_world_aligned"`` (world axes, torque about the body origin).
     """
-    codes = {"local": 0, "world": 1, "local_world_aligned": 2}
+    if f_ext is None and frame in _WRENCH_FRAMES:
+        zero = model._kernel["zero_wrench"]
+        return (zero if batch == () else zero[None]), -1
+    codes = _WRENCH_FRAMES
     if frame not in codes:
         raise ValueError(f"f_ext_frame must be one of {sorted(codes)}, got {frame!r}")
     nb = model.nbodies
-    zero = model._kernel["zero_wrench"]
-    if f_ext is None:
-        return (zero if batch == () else zero[None]), -1
     f = _as_float("f_ext", f_ext)
     if f.ndim < 2 or f.shape[-2:] != (nb, 6):
         raise ValueError(f"f_ext: expected shape (..., {nb}, 6), got {f.shape}")
@@ -127,8 +137,10 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
     ``status`` is an int (single state) or an int array (batch); ``arrays`` are the inputs as
     given to the kernel, used to say where the problem is.
     """
-    if np.ndim(status) == 0:
-        code = int(status)
+    if type(status) is int:
+        if status == OK:
+            return 0
+        code = status
     else:
         bad = np.flatnonzero(status)
         if bad.size == 0:

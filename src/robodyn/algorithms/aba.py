@@ -38,7 +38,7 @@ def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6, 6)), np.empty((nb, 6)),
             np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)), np.empty(nv), np.empty((3, 3)),
-            np.empty(3), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, 12)),
+            np.empty(3), np.empty((3, 3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((6, 12)),
             np.empty(6), np.empty(6), np.empty((6, 6)))
 
 
@@ -82,7 +82,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
     ``i + 1`` when the articulated inertia of body ``i`` is singular."""
     (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
-     X, tmp, UD, G, t1, t2, Ia) = ws
+     B3, PB, UD, G, t1, t2, Ia) = ws
     nb = ints.shape[0]
     if check and not (finite(q) and finite(v) and finite(tau)):
         return NONFINITE
@@ -152,7 +152,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
                 for j in range(n):
                     s += UD[r, j] * u[iv + j]
                 t2[r] = s
-            congruence_to_parent(liR[i], lip[i], Ia, X, tmp, IA[par])
+            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
             force_act(liR[i], lip[i], t2, t1)
             for r in range(6):
                 pA[par, r] += t1[r]

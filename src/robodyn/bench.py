@@ -1,0 +1,186 @@
+"""Timings of robodyn's algorithms, and the same calls in Pinocchio when it is installed.
+
+``robodyn bench [MODEL]`` prints per-call times of single calls (input checks on) and
+per-state times of batched calls, for ``rnea``, ``aba``, ``crba`` and ``coriolis_matrix``.
+When Pinocchio (``pip install pin``) is importable, the model is converted with
+:func:`to_pinocchio` and Pinocchio's Python calls are timed on the same states in the same
+process, with the ratio robodyn / Pinocchio (below 1 means robodyn is faster).
+
+Pinocchio is never a runtime dependency: it is imported only here, only when asked for.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from . import joints as J
+
+
+def to_pinocchio(model):
+    """The same robot as a Pinocchio model (joint order, placements, inertias, armature).
+
+    Revolute and prismatic joints on a coordinate axis become Pinocchio's RX/RY/RZ/PX/PY/PZ
+    joints, others its unaligned variants; a free joint becomes a free flyer.
+    """
+    import pinocchio as pin
+
+    pm = pin.Model()
+    pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float), np.zeros(3))
+    aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
+               J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}
+    unaligned = {J.REVOLUTE: pin.JointModelRevoluteUnaligned, J.PRISMATIC: pin.JointModelPrismaticUnaligned}
+    for i in range(model.nbodies):
+        jt, axis = int(model.joint_type[i]), model.joint_axis[i]
+        if jt == J.FREE:
+            jm = pin.JointModelFreeFlyer()
+        else:
+            k = int(np.argmax(np.abs(axis)))
+            if abs(axis[k]) == 1.0 and axis[k] > 0:
+                jm = aligned[jt][k]()
+            else:
+                jm = unaligned[jt](*axis)
+        placement = pin.SE3(np.asarray(model.X_tree_R[i]), np.asarray(model.X_tree_p[i]))
+        jid = pm.addJoint(int(model.parent[i]) + 1, jm, placement, model.body_joint_names[i])
+        theta = model.inertia[i]
+        m = theta[0]
+        if m > 0:
+            c = theta[1:4] / m
+            Io = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
+            Ic = Io - m * (c @ c * np.eye(3) - np.outer(c, c))
+            inertia = pin.Inertia(m, c, Ic)
+        else:
+            inertia = pin.Inertia.Zero()
+        pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
+    pm.armature = np.asarray(model.armature, dtype=float).copy()
+    return pm
+
+
+@dataclass
+class Timing:
+    name: str
+    robodyn_us: float
+    other_us: float | None = None
+
+    @property
+    def ratio(self) -> float | None:
+        return None if self.other_us is None else self.robodyn_us / self.other_us
+
+
+def per_call_us(fn, min_time: float = 0.2, repeat: int = 5) -> float:
+    """Best-of-``repeat`` time of one call of ``fn`` in microseconds."""
+    fn()
+    n = 1
+    while True:
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fn()
+        dt = time.perf_counter() - t0
+        if dt > min_time / repeat or n > 1_000_000:
+            break
+        n *= 4
+    best = dt / n
+    for _ in range(repeat - 1):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fn()
+        best = min(best, (time.perf_counter() - t0) / n)
+    return best * 1e6
+
+
+def states(model, batch: int, seed: int = 0):
+    """Random states: single ``(q, v, a)`` and batched ``(Q, V, A)`` of ``batch`` rows."""
+    from .random import random_state
+
+    rng = np.random.default_rng(seed)
+    Q, V, A = random_state(model, rng, batch)
+    return (Q[0].copy(), V[0].copy(), A[0].copy()), (Q, V, A)
+
+
+def single_call_timings(model, pm=None, seed: int = 0) -> list[Timing]:
+    """Per-call times of robodyn (and Pinocchio's Python API if ``pm`` is given)."""
+    import robodyn as rd
+
+    (q, v, a), _ = states(model, 1, seed)
+    calls = {
+        "rnea": lambda: rd.rnea(model, q, v, a),
+        "aba": lambda: rd.aba(model, q, v, a),
+        "crba": lambda: rd.crba(model, q),
+        "coriolis_matrix": lambda: rd.coriolis_matrix(model, q, v),
+    }
+    pin_calls = {}
+    if pm is not None:  # the converted model has the same q layout (one angle per joint)
+        import pinocchio as pin
+
+        pd = pm.createData()
+        pin_calls = {
+            "rnea": lambda: pin.rnea(pm, pd, q, v, a),
+            "aba": lambda: pin.aba(pm, pd, q, v, a),
+            "crba": lambda: pin.crba(pm, pd, q),
+            "coriolis_matrix": lambda: pin.computeCoriolisMatrix(pm, pd, q, v),
+        }
+    return [Timing(name, per_call_us(fn), per_call_us(pin_calls[name]) if pin_calls else None)
+            for name, fn in calls.items()]
+
+
+def batch_timings(model, batch: int, pm=None, seed: int = 0) -> list[Timing]:
+    """Per-state times of batched calls; Pinocchio's ``rneaInParallel``/``abaInParallel``
+    with the same number of threads, and Python loops over ``crba``/``computeCoriolisMatrix``."""
+    import robodyn as rd
+
+    _, (Q, V, A) = states(model, batch, seed)
+    threads = numba.get_num_threads()
+    out = [
+        Timing("rnea (batch)", per_call_us(lambda: rd.rnea(model, Q, V, A), repeat=3) / batch),
+        Timing("aba (batch)", per_call_us(lambda: rd.aba(model, Q, V, A), repeat=3) / batch),
+        Timing("crba (batch)", per_call_us(lambda: rd.crba(model, Q), repeat=3) / batch),
+        Timing("coriolis_matrix (batch)", per_call_us(lambda: rd.coriolis_matrix(model, Q, V), repeat=3) / batch),
+    ]
+    if pm is not None:
+        import pinocchio as pin
+
+        pool = pin.ModelPool(pm, threads)
+        Qt, Vt, At = (np.asfortranarray(X.T) for X in (Q, V, A))
+        tau = np.zeros((model.nv, batch), order="F")
+        pd = pm.createData()
+        n_loop = min(batch, 2000)
+        others = [
+            per_call_us(lambda: pin.rneaInParallel(threads, pool, Qt, Vt, At, tau), repeat=3) / batch,
+            per_call_us(lambda: pin.abaInParallel(threads, pool, Qt, Vt, At, tau), repeat=3) / batch,
+            per_call_us(lambda: [pin.crba(pm, pd, Q[s]) for s in range(n_loop)], repeat=3) / n_loop,
+            per_call_us(lambda: [pin.computeCoriolisMatrix(pm, pd, Q[s], V[s]) for s in range(n_loop)], repeat=3) / n_loop,
+        ]
+        for t, o in zip(out, others):
+            t.other_us = o
+    return out
+
+
+def format_table(rows: list[Timing], other: str = "pinocchio") -> str:
+    lines = [f"  {'call':<26} {'robodyn us':>11} {other + ' us':>14} {'ratio':>7}"]
+    for t in rows:
+        o = "" if t.other_us is None else f"{t.other_us:14.3f}"
+        r = "" if t.ratio is None else f"{t.ratio:7.2f}"
+        lines.append(f"  {t.name:<26} {t.robodyn_us:11.3f} {o:>14} {r:>7}")
+    return "\n".join(lines)
+
+
+def run_bench(model, label: str, batch: int = 10000, compare: bool = True) -> int:
+    """Print robodyn's timings for ``model`` (and Pinocchio's, if installed and ``compare``)."""
+    pm = None
+    if compare:
+        try:
+            pm = to_pinocchio(model)
+        except ImportError:
+            print("(Pinocchio is not installed: robodyn timings only; `pip install pin` to compare)")
+    print(f"robodyn bench on {label!r}: nq={model.nq}, nv={model.nv}, {model.nbodies} bodies, "
+          f"{numba.get_num_threads()} threads")
+    print("Single calls from Python (input checks on), microseconds per call:")
+    print(format_table(single_call_timings(model, pm)))
+    print(f"Batches of {batch} states, microseconds per state:")
+    print(format_table(batch_timings(model, batch, pm)))
+    if pm is not None:
+        print("ratio = robodyn / pinocchio: below 1 means robodyn is faster")
+    return 0
