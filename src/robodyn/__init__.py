@@ -21,6 +21,7 @@ from .algorithms.jacobian import jacobian, jacobian_dot_times_v
 from .algorithms.kinematics import forward_kinematics, frame_pose
 from .algorithms.rnea import rnea
 from .algorithms.terms import generalized_momentum, gravity, nonlinear_effects
+from .warmup import warmup
 
 __version__ = "0.1.0"
 
@@ -28,5 +29,5 @@ __all__ = [
     "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh",
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
-    "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose",
+    "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
 ]

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ..spatial import dot6, inertia_matrix, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
+from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
 from ._inputs import NONFINITE, OK, finite
@@ -40,17 +40,21 @@ def workspace(nb, nv):
 
 
 @njit(cache=True, inline="always")
-def body_B(theta, V, Imat, Vx, h, B):
-    """``B = 1/2 [ (V x*) I - I (V x) + (I V) xbar ]`` (6 x 6) of one body."""
-    inertia_matrix(theta, Imat)
+def body_B(theta, V, K, Vx, h, B):
+    """``B = 1/2 [ (V x*) I - I (V x) + (I V) xbar ]`` (6 x 6) of one body.
+
+    With ``K = I (V x)`` and ``(V x*) = -(V x)^T``: ``(V x*) I - I (V x) = -(K + K^T)``.
+    """
     motion_cross_matrix(V, Vx)
-    matvec6(Imat, V, h)
+    for c in range(6):
+        inertia_mul(theta, Vx[:, c], h)
+        for r in range(6):
+            K[r, c] = h[r]
     for r in range(6):
-        for c in range(6):
-            s = 0.0
-            for k in range(6):
-                s += -Vx[k, r] * Imat[k, c] - Imat[r, k] * Vx[k, c]
-            B[r, c] = 0.5 * s
+        for c in range(r, 6):
+            B[r, c] = -0.5 * (K[r, c] + K[c, r])
+            B[c, r] = B[r, c]
+    inertia_mul(theta, V, h)
     # (h xbar) = [[0, -[f]x], [-[f]x, -[n]x]] with h = [f; n]
     f0, f1, f2, n0, n1, n2 = h[0], h[1], h[2], h[3], h[4], h[5]
     for o_r, o_c, a0, a1, a2 in ((0, 3, f0, f1, f2), (3, 0, f0, f1, f2), (3, 3, n0, n1, n2)):
@@ -64,7 +68,7 @@ def body_B(theta, V, Imat, Vx, h, B):
 
 @njit(cache=True)
 def coriolis_one(ints, body, dofs, q, v, check, C, ws):
-    liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, Imat, Vx, F1, F2, F3, h = ws
+    liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
     if check and not finite(v):
         return NONFINITE
@@ -82,7 +86,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
                 oV[i, r] += oS[k, r] * v[k]
         for k in range(iv, iv + n):
             motion_cross(oV[i], oS[k], oSd[k])
-        body_B(Ic[i], oV[i], Imat, Vx, h, Bc[i])
+        body_B(Ic[i], oV[i], K, Vx, h, Bc[i])
     C[:, :] = 0.0
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
