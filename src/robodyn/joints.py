@@ -17,8 +17,8 @@ free        7    6    ``[x, y, z, qx, qy, qz, qw]``, ``[v_lin, omega]`` in the c
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
+from ._jit import inline
 from .spatial import rotation_axis_angle, rotation_from_quaternion
 
 REVOLUTE = 0
@@ -45,7 +45,7 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
 QUAT_TOL = 1e-3
 
 
-@njit(cache=True, inline="always")
+@inline
 def joint_transform(jtype, axis, q, iq, R, p):
     """Placement ``(R, p)`` of the child frame in the joint frame at configuration ``q``.
 
@@ -73,7 +73,7 @@ def joint_transform(jtype, axis, q, iq, R, p):
     return True
 
 
-@njit(cache=True, inline="always")
+@inline
 def friction_torque(dofs, eps, v, k):
     """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
 

@@ -24,12 +24,10 @@ nothing in their loops. Reference: R. Featherstone, *Rigid Body Dynamics Algorit
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
-_JIT = dict(cache=True, fastmath=False, inline="always")
+from ._jit import inline
 
-
-@njit(**_JIT)
+@inline
 def cross3(a, b, out):
     """``out = a x b`` for 3-vectors (``out`` must not alias ``a`` or ``b``)."""
     out[0] = a[1] * b[2] - a[2] * b[1]
@@ -37,7 +35,7 @@ def cross3(a, b, out):
     out[2] = a[0] * b[1] - a[1] * b[0]
 
 
-@njit(**_JIT)
+@inline
 def rotation_axis_angle(axis, angle, R):
     """Rodrigues' formula: rotation by ``angle`` about the unit ``axis``."""
     x, y, z = axis[0], axis[1], axis[2]
@@ -55,7 +53,7 @@ def rotation_axis_angle(axis, angle, R):
     R[2, 2] = t * z * z + c
 
 
-@njit(**_JIT)
+@inline
 def rotation_from_quaternion(qx, qy, qz, qw, R):
     """Rotation matrix of the unit quaternion ``(qx, qy, qz, qw)`` (scalar last)."""
     R[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
@@ -69,7 +67,7 @@ def rotation_from_quaternion(qx, qy, qz, qw, R):
     R[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
 
 
-@njit(**_JIT)
+@inline
 def compose(Ra, pa, Rb, pb, R, p):
     """``(R, p) = (Ra, pa) * (Rb, pb)``: ``R = Ra Rb``, ``p = pa + Ra pb``."""
     for r in range(3):
@@ -78,7 +76,7 @@ def compose(Ra, pa, Rb, pb, R, p):
             R[r, c] = Ra[r, 0] * Rb[0, c] + Ra[r, 1] * Rb[1, c] + Ra[r, 2] * Rb[2, c]
 
 
-@njit(**_JIT)
+@inline
 def motion_act(R, p, m, out):
     """Motion vector from child to parent coordinates: ``[R v + p x R w; R w]``."""
     w0 = R[0, 0] * m[3] + R[0, 1] * m[4] + R[0, 2] * m[5]
@@ -95,7 +93,7 @@ def motion_act(R, p, m, out):
     out[5] = w2
 
 
-@njit(**_JIT)
+@inline
 def motion_act_inv(R, p, m, out):
     """Motion vector from parent to child coordinates: ``[R^T (v - p x w); R^T w]``."""
     u0 = m[0] - (p[1] * m[5] - p[2] * m[4])
@@ -110,7 +108,7 @@ def motion_act_inv(R, p, m, out):
     out[5] = R[0, 2] * w0 + R[1, 2] * w1 + R[2, 2] * w2
 
 
-@njit(**_JIT)
+@inline
 def force_act(R, p, f, out):
     """Force vector from child to parent coordinates: ``[R f; R n + p x R f]``."""
     f0 = R[0, 0] * f[0] + R[0, 1] * f[1] + R[0, 2] * f[2]
@@ -127,7 +125,7 @@ def force_act(R, p, f, out):
     out[5] = n2 + p[0] * f1 - p[1] * f0
 
 
-@njit(**_JIT)
+@inline
 def force_act_inv(R, p, f, out):
     """Force vector from parent to child coordinates: ``[R^T f; R^T (n - p x f)]``."""
     u0 = f[3] - (p[1] * f[2] - p[2] * f[1])
@@ -142,7 +140,7 @@ def force_act_inv(R, p, f, out):
     out[5] = R[0, 2] * u0 + R[1, 2] * u1 + R[2, 2] * u2
 
 
-@njit(**_JIT)
+@inline
 def motion_cross(m, n, out):
     """Spatial cross product of motions, ``out = m x n = [w x v' + v x w'; w x w']``."""
     v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
@@ -154,7 +152,7 @@ def motion_cross(m, n, out):
     out[5] = w0 * n[4] - w1 * n[3]
 
 
-@njit(**_JIT)
+@inline
 def force_cross(m, f, out):
     """Dual cross product, ``out = m x* f = [w x f; w x n + v x f]``."""
     v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
@@ -166,7 +164,7 @@ def force_cross(m, f, out):
     out[5] = w0 * f[4] - w1 * f[3] + v0 * f[1] - v1 * f[0]
 
 
-@njit(**_JIT)
+@inline
 def inertia_mul(theta, m, out):
     """Momentum of a motion: ``out = I m`` with ``I`` given by its 10 parameters.
 
@@ -183,7 +181,7 @@ def inertia_mul(theta, m, out):
     out[5] = ixz * w0 + iyz * w1 + izz * w2 + (hx * v1 - hy * v0)
 
 
-@njit(**_JIT)
+@inline
 def inertia_act(R, p, theta, out):
     """Inertial parameters of a body expressed in the parent frame of placement ``(R, p)``.
 
@@ -227,7 +225,7 @@ def inertia_act(R, p, theta, out):
     out[9] = j22 - 2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
 
 
-@njit(**_JIT)
+@inline
 def inertia_matrix(theta, out):
     """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters."""
     mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
@@ -261,12 +259,12 @@ def inertia_matrix(theta, out):
     out[5, 5] = theta[9]
 
 
-@njit(**_JIT)
+@inline
 def dot6(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
 
 
-@njit(**_JIT)
+@inline
 def matvec6(A, x, out):
     for r in range(6):
         s = 0.0
@@ -275,7 +273,7 @@ def matvec6(A, x, out):
         out[r] = s
 
 
-@njit(**_JIT)
+@inline
 def matTvec6(A, x, out):
     for r in range(6):
         s = 0.0
@@ -284,7 +282,7 @@ def matTvec6(A, x, out):
         out[r] = s
 
 
-@njit(**_JIT)
+@inline
 def congruence_to_parent(R, p, A, B, PB, out):
     """``out += X^T A X`` for a symmetric 6 x 6 ``A`` (an articulated inertia in the child
     frame), ``X`` the parent-to-child motion transform of ``(R, p)``.
@@ -340,7 +338,7 @@ def congruence_to_parent(R, p, A, B, PB, out):
         out[3 + r, 5] += B[2, r, 2] + PB[r, 2] + PB[2, r] - pbp2
 
 
-@njit(**_JIT)
+@inline
 def motion_cross_matrix(m, out):
     """6 x 6 matrix of ``n -> m x n``."""
     for r in range(6):
@@ -363,7 +361,7 @@ def motion_cross_matrix(m, out):
     out[2, 4] = v0
 
 
-@njit(**_JIT)
+@inline
 def wrench_to_local(frame, R, p, f, out):
     """A wrench ``[force; torque]`` given in ``frame`` expressed in the body frame ``(R, p)``.
 

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numba
 import numpy as np
-from numba import njit
 
+from .._jit import inline
 from .. import joints as J
 
 OK = 0
@@ -26,7 +26,7 @@ NONFINITE = -1
 BAD_QUATERNION = -2
 
 
-@njit(cache=True, inline="always")
+@inline
 def finite(x):
     """True when every entry of the 1-D array ``x`` is finite."""
     for k in range(x.shape[0]):

@@ -20,8 +20,9 @@ forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import inline, kernel, parallel
 from ..joints import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
                        matvec6, motion_act_inv, motion_cross, wrench_to_local)
@@ -33,7 +34,7 @@ from .kinematics import placements, world_placements
 SINGULAR_RTOL = 1e-12
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6, 6)), np.empty((nb, 6)),
@@ -42,7 +43,7 @@ def workspace(nb, nv):
             np.empty(6), np.empty(6), np.empty((6, 6)))
 
 
-@njit(cache=True, inline="always")
+@inline
 def invert_block(Dinv, iv, n, G, tol):
     """Invert the n x n block ``Dinv[iv:iv+n, :n]`` in place (Gauss-Jordan, partial pivoting).
 
@@ -77,7 +78,7 @@ def invert_block(Dinv, iv, n, G, tol):
     return True
 
 
-@njit(cache=True)
+@kernel
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
     ``i + 1`` when the articulated inertia of body ``i`` is singular."""
@@ -184,7 +185,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
@@ -194,7 +195,7 @@ def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, 
                                 fcode, check, QDD[s], ws)
 
 
-@njit(cache=True)
+@kernel
 def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
     return aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd,
                    workspace(ints.shape[0], dofs.shape[0]))

@@ -11,21 +11,22 @@ body ``i`` and ``S_k = [S_lin,k; S_ang,k]`` the world-frame motion subspace colu
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import kernel, parallel
 from . import _inputs
 from .crba import world_inertias
 from ._inputs import OK
 from .kinematics import poses_checked, world_motion_subspace
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)))
 
 
-@njit(cache=True)
+@kernel
 def com_one(ints, body, dofs, q, check, c, Jc, ws):
     """Centre of mass ``c`` (3,) and, if ``Jc`` has columns, its Jacobian (3, nv)."""
     liR, lip, oR, op, Rj, pj, oS, Ic = ws
@@ -61,7 +62,7 @@ def com_one(ints, body, dofs, q, check, c, Jc, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _com_batch(ints, body, dofs, Q, check, C, JC, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):

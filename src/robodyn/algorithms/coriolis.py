@@ -22,8 +22,9 @@ of the first kind ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import inline, kernel, parallel
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
@@ -31,7 +32,7 @@ from ._inputs import NONFINITE, OK, finite
 from .kinematics import poses_checked, world_motion_subspace
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nv, 6)), np.empty((nb, 10)),
@@ -39,7 +40,7 @@ def workspace(nb, nv):
             np.empty(6), np.empty(6), np.empty(6))
 
 
-@njit(cache=True, inline="always")
+@inline
 def body_B(theta, V, K, Vx, h, B):
     """``B = 1/2 [ (V x*) I - I (V x) + (I V) xbar ]`` (6 x 6) of one body.
 
@@ -66,7 +67,7 @@ def body_B(theta, V, K, Vx, h, B):
         B[o_r + 2, o_c + 1] -= 0.5 * a0
 
 
-@njit(cache=True)
+@kernel
 def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
@@ -114,7 +115,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _coriolis_batch(ints, body, dofs, Q, V, check, CC, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
@@ -123,7 +124,7 @@ def _coriolis_batch(ints, body, dofs, Q, V, check, CC, status, nchunk):
             status[s] = coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
 
 
-@njit(cache=True)
+@kernel
 def _coriolis_single(ints, body, dofs, q, v, check, C):
     return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 

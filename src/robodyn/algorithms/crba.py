@@ -14,28 +14,29 @@ Returns the full symmetric matrix.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import inline, kernel, parallel
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
 from ._inputs import OK
 from .kinematics import poses_checked, world_motion_subspace
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)), np.empty(6))
 
 
-@njit(cache=True, inline="always")
+@inline
 def world_inertias(ints, body, oR, op, Ic):
     """``Ic[i]``: inertial parameters of body ``i`` in world coordinates."""
     for i in range(ints.shape[0]):
         inertia_act(oR[i], op[i], body[i, 15:25], Ic[i])
 
 
-@njit(cache=True)
+@kernel
 def crba_one(ints, body, dofs, q, check, M, ws):
     liR, lip, oR, op, Rj, pj, oS, Ic, F = ws
     status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
@@ -62,7 +63,7 @@ def crba_one(ints, body, dofs, q, check, M, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
@@ -71,7 +72,7 @@ def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
             status[s] = crba_one(ints, body, dofs, Q[s], check, MM[s], ws)
 
 
-@njit(cache=True)
+@kernel
 def _crba_single(ints, body, dofs, q, check, M):
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 

@@ -10,8 +10,9 @@ Armature (rotor) kinetic energy is not included: it belongs to the motors, see `
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import kernel, parallel
 from ..spatial import dot6, inertia_mul
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
@@ -19,14 +20,14 @@ from .kinematics import poses_checked
 from .rnea import motion_pass
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
             np.empty(6), np.zeros(nv), np.zeros(3))
 
 
-@njit(cache=True)
+@kernel
 def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic energy (when ``v`` has entries), ``out[1]`` potential energy."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
@@ -51,7 +52,7 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):

@@ -17,8 +17,9 @@ frame when ``qdd = 0`` (and no gravity), spatial for ``"local"``/``"world"`` and
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import kernel, parallel
 from ..spatial import motion_act
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
@@ -28,14 +29,14 @@ from .rnea import motion_pass
 FRAMES = ("world", "local", "local_world_aligned")
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
             np.empty(6), np.zeros(nv), np.zeros(3))
 
 
-@njit(cache=True)
+@kernel
 def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws):
     """World Jacobian ``J`` (6, nv) of body ``b``, its pose, and (when ``v`` has entries) the
     body-frame velocity and acceleration of ``b`` at ``qdd = 0`` without gravity."""
@@ -60,7 +61,7 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):

@@ -11,15 +11,16 @@ passes here (``placements``, ``world_placements``) are the first pass of every a
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import inline, kernel, parallel
 from ..joints import joint_transform
 from ..spatial import compose, motion_act
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
 
 
-@njit(cache=True, inline="always")
+@inline
 def placements(ints, body, q, liR, lip, Rj, pj):
     """``liR[i], lip[i]``: placement of body ``i`` in its parent at configuration ``q``.
 
@@ -36,7 +37,7 @@ def placements(ints, body, q, liR, lip, Rj, pj):
     return True
 
 
-@njit(cache=True, inline="always")
+@inline
 def world_placements(ints, liR, lip, oR, op):
     """``oR[i], op[i]``: placement of body ``i`` in the world from the local placements."""
     for i in range(ints.shape[0]):
@@ -48,7 +49,7 @@ def world_placements(ints, liR, lip, oR, op):
             compose(oR[par], op[par], liR[i], lip[i], oR[i], op[i])
 
 
-@njit(cache=True, inline="always")
+@inline
 def world_motion_subspace(ints, dofs, oR, op, oS):
     """``oS[k]``: motion subspace column ``k`` in world coordinates (``J`` of its body)."""
     for i in range(ints.shape[0]):
@@ -56,7 +57,7 @@ def world_motion_subspace(ints, dofs, oR, op, oS):
             motion_act(oR[i], op[i], dofs[k, :6], oS[k])
 
 
-@njit(cache=True, inline="always")
+@inline
 def poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op):
     """Local and world placements of every body, with the input checks; returns a status."""
     if check and not finite(q):
@@ -67,18 +68,18 @@ def poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op):
     return OK
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb):
     return np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3)
 
 
-@njit(cache=True)
+@kernel
 def _fk_single(ints, body, q, oR, op, check):
     liR, lip, Rj, pj = workspace(ints.shape[0])
     return poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _fk_batch(ints, body, Q, OR, OP, check, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):

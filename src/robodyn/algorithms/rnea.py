@@ -17,8 +17,9 @@ Pass 2 (leaves to root)::
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
 
+from .._jit import inline, kernel, parallel
 from ..joints import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
@@ -26,14 +27,14 @@ from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
 from .kinematics import placements, world_placements
 
 
-@njit(cache=True)
+@kernel
 def workspace(nb):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty((3, 3)), np.empty(3),
             np.empty(6), np.empty(6), np.empty(6))
 
 
-@njit(cache=True, inline="always")
+@inline
 def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
     """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the
     base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
@@ -61,7 +62,7 @@ def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
             acc[i, r] += t1[r]
 
 
-@njit(cache=True)
+@kernel
 def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
 
@@ -103,7 +104,7 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     return OK
 
 
-@njit(cache=True, parallel=True)
+@parallel
 def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
@@ -113,7 +114,7 @@ def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status,
                                  fcode, check, TAU[s], ws)
 
 
-@njit(cache=True)
+@kernel
 def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
     return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
 
