@@ -1,0 +1,268 @@
+"""Helpers shared by the core-dynamics tests (test_rnea.py, test_aba.py, ...).
+
+* seeded random trees (``RANDOM_MODELS``, decorator ``random_models``) and their states;
+* ``assert_rel``: the relative-error criterion of the tests;
+* motion on the configuration manifold: ``integrate`` (exact for 1-dof joints, exponential
+  map in the base frame for the free joint) and ``configuration_rate`` (``dq/dt`` for ODE
+  integration), ``directional_derivative`` (central differences along ``v``);
+* the textbook pendulum and two-link planar arm built with ``rd.ModelBuilder``;
+* ``check_batch`` and ``check_input_validation``: batch and bad-input behaviour of any
+  public function, so that every test file checks its own functions the same way.
+"""
+
+from __future__ import annotations
+
+import re
+import zlib
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import robodyn as rd
+from robodyn import joints as J
+from robodyn.random import random_model, random_state
+
+G = 9.81
+
+# (bodies, seed, floating base, branching): chains, branches, 1..15 bodies, both base types
+RANDOM_CASES = [
+    (1, 0, False, 0.3), (1, 1, True, 0.3), (2, 2, False, 0.5), (3, 3, True, 0.9), (5, 4, False, 0.7),
+    (7, 5, True, 0.3), (10, 6, False, 0.0), (12, 7, True, 0.5), (15, 8, False, 0.9), (15, 9, True, 0.3),
+]
+RANDOM_MODELS = [random_model(n, seed=s, floating_base=fb, branching=b) for n, s, fb, b in RANDOM_CASES]
+RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}" for n, s, fb, b in RANDOM_CASES]
+FIXED_BASE_MODELS = [m for m in RANDOM_MODELS if not m.floating_base]
+FIXED_BASE_IDS = [i for m, i in zip(RANDOM_MODELS, RANDOM_IDS) if not m.floating_base]
+
+random_models = pytest.mark.parametrize("model", RANDOM_MODELS, ids=RANDOM_IDS)
+fixed_base_models = pytest.mark.parametrize("model", FIXED_BASE_MODELS, ids=FIXED_BASE_IDS)
+
+F_EXT_FRAMES = ("local", "world", "local_world_aligned")
+
+
+def rng_for(*keys) -> np.random.Generator:
+    """A generator seeded by the test's own keys (model name, frame, ...): reproducible and
+    independent of test order."""
+    return np.random.default_rng(zlib.crc32(repr(keys).encode()))
+
+
+def states(model: rd.Model, *keys, size=()):
+    """Random ``(q, v, a)`` for ``model`` seeded by its name and ``keys``."""
+    return random_state(model, rng_for(model.name, *keys), size)
+
+
+def with_friction_and_armature(model: rd.Model, rng: np.random.Generator, smoothing: float = 0.0) -> rd.Model:
+    """The model with random viscous and Coulomb friction and armature on every dof."""
+    return model.replace(damping=rng.uniform(0.1, 1.0, model.nv), coulomb=rng.uniform(0.1, 1.0, model.nv),
+                         armature=rng.uniform(0.01, 0.1, model.nv), coulomb_smoothing=smoothing)
+
+
+def rel_error(actual, expected) -> float:
+    """``max |actual - expected| / max(1, max |expected|)``."""
+    actual, expected = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
+    assert actual.shape == expected.shape, f"shape {actual.shape} != expected {expected.shape}"
+    if expected.size == 0:
+        return 0.0
+    return float(np.max(np.abs(actual - expected)) / max(1.0, np.max(np.abs(expected))))
+
+
+def assert_rel(actual, expected, tol: float = 1e-9, what: str = "") -> None:
+    """Relative error (see :func:`rel_error`) at most ``tol``."""
+    err = rel_error(actual, expected)
+    assert err <= tol, f"{what}: relative error {err:.3g} > {tol:g}\nactual={actual}\nexpected={expected}"
+
+
+def unit(n: int, j: int) -> np.ndarray:
+    e = np.zeros(n)
+    e[j] = 1.0
+    return e
+
+
+# -- quaternions (x, y, z, w), as in q ----------------------------------------------------
+def quat_mul(a, b) -> np.ndarray:
+    """Hamilton product ``a b`` of quaternions ``(x, y, z, w)``."""
+    av, aw, bv, bw = np.asarray(a[:3]), a[3], np.asarray(b[:3]), b[3]
+    return np.concatenate([aw * bv + bw * av + np.cross(av, bv), [aw * bw - av @ bv]])
+
+
+def quat_exp(w) -> np.ndarray:
+    """Unit quaternion of the rotation vector ``w``."""
+    angle = np.linalg.norm(w)
+    if angle == 0.0:
+        return np.array([0.0, 0.0, 0.0, 1.0])
+    return np.concatenate([np.sin(angle / 2) * np.asarray(w) / angle, [np.cos(angle / 2)]])
+
+
+def quat_to_matrix(quat) -> np.ndarray:
+    """Rotation matrix of a quaternion (x, y, z, w), normalised first (as robodyn does)."""
+    return Rotation.from_quat(quat).as_matrix()
+
+
+def _free_joints(model: rd.Model):
+    for i in np.flatnonzero(model.joint_type == J.FREE):
+        yield int(model.idx_q[i]), int(model.idx_v[i])
+
+
+def _scalar_joints(model: rd.Model) -> tuple[np.ndarray, np.ndarray]:
+    one = model.joint_type != J.FREE
+    return model.idx_q[one], model.idx_v[one]
+
+
+def integrate(model: rd.Model, q, v, dt: float) -> np.ndarray:
+    """``q`` moved for ``dt`` along ``v``: 1-dof joints by ``v dt``; a free joint's position by
+    ``R v_lin dt`` and its orientation by ``R exp(omega dt)`` (``v`` in the base frame), so
+    that the curve leaves ``q`` with velocity ``v``."""
+    q = np.array(q, dtype=float)
+    out = q.copy()
+    iq, iv = _scalar_joints(model)
+    out[iq] += v[iv] * dt
+    for kq, kv in _free_joints(model):
+        R = quat_to_matrix(q[kq + 3:kq + 7])
+        out[kq:kq + 3] += R @ v[kv:kv + 3] * dt
+        out[kq + 3:kq + 7] = quat_mul(q[kq + 3:kq + 7], quat_exp(v[kv + 3:kv + 6] * dt))
+    return out
+
+
+def configuration_rate(model: rd.Model, q, v) -> np.ndarray:
+    """``dq/dt`` for velocity ``v`` (free joint: ``R v_lin`` and ``quat (omega, 0) / 2``)."""
+    qd = np.zeros(model.nq)
+    iq, iv = _scalar_joints(model)
+    qd[iq] = v[iv]
+    for kq, kv in _free_joints(model):
+        qd[kq:kq + 3] = quat_to_matrix(q[kq + 3:kq + 7]) @ v[kv:kv + 3]
+        qd[kq + 3:kq + 7] = 0.5 * quat_mul(q[kq + 3:kq + 7], np.append(v[kv + 3:kv + 6], 0.0))
+    return qd
+
+
+def directional_derivative(f, model: rd.Model, q, v, h: float = 1e-5) -> np.ndarray:
+    """``d/dt f(q(t))`` at ``t = 0`` along the curve of :func:`integrate`, central differences."""
+    return (np.asarray(f(integrate(model, q, v, h))) - np.asarray(f(integrate(model, q, v, -h)))) / (2 * h)
+
+
+def columns_by_differences(f, model: rd.Model, q, h: float = 1e-5) -> np.ndarray:
+    """``[d f / d e_j]_j``: the derivative of ``f`` along each unit velocity, stacked last."""
+    return np.stack([directional_derivative(f, model, q, unit(model.nv, j), h) for j in range(model.nv)], axis=-1)
+
+
+def rk4(f, x0: np.ndarray, t_end: float, steps: int) -> np.ndarray:
+    """Classic Runge-Kutta integration of ``x' = f(x)`` over ``[0, t_end]``."""
+    x, dt = np.array(x0, dtype=float), t_end / steps
+    for _ in range(steps):
+        k1 = f(x)
+        k2 = f(x + dt / 2 * k1)
+        k3 = f(x + dt / 2 * k2)
+        k4 = f(x + dt * k3)
+        x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    return x
+
+
+# -- closed-form models ---------------------------------------------------------------------
+def pendulum(m: float = 2.0, L: float = 0.7) -> rd.Model:
+    """Point mass ``m`` at distance ``L`` along +z of a link rotating about +y; ``theta = 0``
+    upright, so ``m L^2 qdd = tau + m g L sin(theta)``."""
+    b = rd.ModelBuilder("pendulum-test")
+    b.add_link("base")
+    b.add_link("bob", mass=m, com=(0.0, 0.0, L))
+    b.add_joint("hinge", "revolute", "base", "bob", axis=(0, 1, 0))
+    return b.build()
+
+
+PLANAR_2R = dict(m1=3.0, m2=2.0, l1=0.8, l2=0.6)
+
+
+def planar_2r(m1: float, m2: float, l1: float, l2: float) -> rd.Model:
+    """Two thin uniform rods along x, joints about z, gravity along -y (Spong, ch. 7)."""
+    b = rd.ModelBuilder("planar-2r-test", gravity=(0.0, -G, 0.0))
+    b.add_link("base")
+    b.add_link("rod1", mass=m1, com=(l1 / 2, 0, 0), inertia=np.diag([0.0, m1 * l1 ** 2 / 12, m1 * l1 ** 2 / 12]))
+    b.add_link("rod2", mass=m2, com=(l2 / 2, 0, 0), inertia=np.diag([0.0, m2 * l2 ** 2 / 12, m2 * l2 ** 2 / 12]))
+    b.add_joint("shoulder", "revolute", "base", "rod1", axis=(0, 0, 1))
+    b.add_joint("elbow", "revolute", "rod1", "rod2", xyz=(l1, 0, 0), axis=(0, 0, 1))
+    return b.build()
+
+
+def planar_2r_terms(q, qd, m1, m2, l1, l2):
+    """Textbook ``M``, ``C`` and ``g`` of the two-link planar arm (Spong, Hutchinson and
+    Vidyasagar, Robot Modeling and Control, 2006, section 7.4)."""
+    r1, r2 = l1 / 2, l2 / 2
+    Iz1, Iz2 = m1 * l1 ** 2 / 12, m2 * l2 ** 2 / 12
+    alpha = Iz1 + Iz2 + m1 * r1 ** 2 + m2 * (l1 ** 2 + r2 ** 2)
+    beta = m2 * l1 * r2
+    delta = Iz2 + m2 * r2 ** 2
+    c2, s2 = np.cos(q[1]), np.sin(q[1])
+    M = np.array([[alpha + 2 * beta * c2, delta + beta * c2], [delta + beta * c2, delta]])
+    C = np.array([[-beta * s2 * qd[1], -beta * s2 * (qd[0] + qd[1])], [beta * s2 * qd[0], 0.0]])
+    g = np.array([(m1 * r1 + m2 * l1) * G * np.cos(q[0]) + m2 * r2 * G * np.cos(q[0] + q[1]),
+                  m2 * r2 * G * np.cos(q[0] + q[1])])
+    return M, C, g
+
+
+# -- batch and bad-input checks of any public function ----------------------------------------
+def check_batch(call, model: rd.Model, names, tol: float = 1e-12) -> None:
+    """``call(model, **arrays)`` on a (2, 3) batch equals the individual calls, and a single
+    ``q`` (nq,) broadcasts against the other arrays of shape (4, n)."""
+    rng = rng_for(model.name, "batch", tuple(names))
+    q, v, a = random_state(model, rng, (2, 3))
+    pool = {"q": q, "v": v, "a": a, "tau": a}
+    arrays = {name: pool[name] for name in names}
+    batch = np.asarray(call(model, **arrays))
+    assert batch.shape[:2] == (2, 3)
+    for i in np.ndindex(2, 3):
+        assert_rel(batch[i], call(model, **{k: x[i] for k, x in arrays.items()}), tol, f"batch element {i}")
+    if len(names) > 1:
+        wide = {k: (x[0, 0] if k == "q" else np.concatenate([x[0], x[1, :1]])) for k, x in arrays.items()}
+        out = np.asarray(call(model, **wide))
+        assert out.shape[0] == 4
+        for i in range(4):
+            assert_rel(out[i], call(model, **{k: (x if k == "q" else x[i]) for k, x in wide.items()}), tol,
+                       f"broadcast element {i}")
+
+
+def _floating_model() -> rd.Model:
+    return random_model(4, seed=3, floating_base=True)
+
+
+def check_input_validation(call, names) -> None:
+    """Bad input to ``call(model, check_finite=..., **arrays)`` (arrays named by ``names``):
+
+    * wrong last dimension, a scalar, or batches that do not broadcast: ValueError naming
+      the argument, the expected and the received shape;
+    * NaN or Inf: ValueError naming the argument, unless ``check_finite=False``;
+    * a quaternion far from unit norm (or zero): ValueError; a near-unit one is normalised.
+    """
+    model = _floating_model()
+    q, v, a = states(model, "bad-input")
+    good = {k: {"q": q, "v": v, "a": a, "tau": a}[k] for k in names}
+    size = {k: model.nq if k == "q" else model.nv for k in names}
+    for name in names:
+        n = size[name]
+        for bad in (np.zeros(n + 1), np.zeros((3, n - 1)), np.float64(1.0)):
+            with pytest.raises(ValueError) as err:
+                call(model, **{**good, name: bad})
+            msg = str(err.value)
+            assert re.match(rf"{name}\b", msg), msg
+            assert f"(..., {n})" in msg and str(np.shape(bad)) in msg, msg
+        if len(names) > 1:
+            other = next(k for k in names if k != name)
+            with pytest.raises(ValueError, match="broadcast") as err:
+                call(model, **{**good, name: np.stack([good[name]] * 2), other: np.stack([good[other]] * 3)})
+            assert str((2, size[name])) in str(err.value) and str((3, size[other])) in str(err.value)
+        for value in (np.nan, np.inf, -np.inf):
+            bad = good[name].copy()
+            bad[-1] = value
+            with pytest.raises(ValueError, match=rf"\b{name}\b.* NaN or Inf"):
+                call(model, **{**good, name: bad})
+            out = np.asarray(call(model, **{**good, name: bad}, check_finite=False))
+            assert out.shape == np.shape(call(model, **good))
+    if "q" not in names:
+        return
+    for factor in (1.5, 0.5, 0.0):
+        bad = q.copy()
+        bad[3:7] *= factor
+        with pytest.raises(ValueError, match=r"\bq\b.* quaternion of free joint 'root_joint'"):
+            call(model, **{**good, "q": bad})
+    for factor in (1 + 5e-4, 1 - 5e-4):
+        near = q.copy()
+        near[3:7] *= factor
+        assert_rel(call(model, **{**good, "q": near}), call(model, **good), 1e-12, f"quaternion scaled by {factor}")
