@@ -1,0 +1,82 @@
+"""Coriolis matrix and Christoffel symbols (robodyn.coriolis_matrix, christoffel_symbols):
+Mdot = C + C^T by finite differences, C v against the RNEA, Christoffel symbols from the
+derivatives of M, the two-link planar arm in closed form, batches and bad input."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, columns_by_differences,
+                     directional_derivative, fixed_base_models, planar_2r, planar_2r_terms, random_model,
+                     random_models, rng_for, states)
+
+
+@random_models
+def test_mass_matrix_derivative_is_c_plus_c_transpose(model):
+    """dM/dt along the motion (quaternion manifold for a floating base) == C + C^T, so
+    Mdot - 2C is skew-symmetric."""
+    q, v, _ = states(model)
+    Mdot = directional_derivative(lambda x: rd.crba(model, x), model, q, v)
+    C = rd.coriolis_matrix(model, q, v)
+    assert_rel(C + C.T, Mdot, 1e-6)
+    S = Mdot - 2 * C
+    assert_rel(S + S.T, np.zeros_like(S), 1e-6)
+
+
+@random_models
+def test_c_times_v_is_the_velocity_product_term(model):
+    q, v, _ = states(model)
+    assert_rel(rd.coriolis_matrix(model, q, v) @ v, rd.nonlinear_effects(model, q, v) - rd.gravity(model, q), 1e-9)
+
+
+@random_models
+def test_linear_in_v(model):
+    q, v, w = states(model)
+    C = functools.partial(rd.coriolis_matrix, model, q)
+    assert_rel(C(2.0 * v - 3.0 * w), 2.0 * C(v) - 3.0 * C(w), 1e-9)
+    assert_rel(C(np.zeros(model.nv)), np.zeros((model.nv, model.nv)), 1e-15)
+
+
+@random_models
+def test_christoffel_symbols_give_c(model):
+    """C == Gamma v; Gamma[:, :, k] == C(q, e_k)."""
+    q, v, _ = states(model)
+    Gamma = rd.christoffel_symbols(model, q)
+    assert Gamma.shape == (model.nv,) * 3
+    assert_rel(np.einsum("ijk,k->ij", Gamma, v), rd.coriolis_matrix(model, q, v), 1e-9)
+
+
+@fixed_base_models
+def test_christoffel_symbols_from_mass_matrix_derivatives(model):
+    """Fixed base: Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2, symmetric in (j, k)."""
+    q, _, _ = states(model)
+    Gamma = rd.christoffel_symbols(model, q)
+    assert_rel(Gamma, Gamma.transpose(0, 2, 1), 1e-9)
+    dM = columns_by_differences(lambda x: rd.crba(model, x), model, q)  # dM[i, j, k] = dM_ij / dq_k
+    expected = 0.5 * (dM + dM.transpose(0, 2, 1) - dM.transpose(2, 0, 1))
+    assert_rel(Gamma, expected, 1e-6)
+
+
+@pytest.mark.parametrize("params", [PLANAR_2R, dict(m1=1.0, m2=4.0, l1=0.3, l2=1.2)], ids=["arm1", "arm2"])
+def test_planar_2r_closed_form(params):
+    """Spong's C = [[-beta s2 qd2, -beta s2 (qd1 + qd2)], [beta s2 qd1, 0]]."""
+    model = planar_2r(**params)
+    for q, qd in rng_for("2r-C", tuple(params.values())).uniform(-3, 3, (6, 2, 2)):
+        _, C, _ = planar_2r_terms(q, qd, **params)
+        assert_rel(rd.coriolis_matrix(model, q, qd), C, 1e-12, f"q={q}, qd={qd}")
+
+
+def test_batch():
+    for model in (random_model(8, seed=41, floating_base=True), random_model(5, seed=42)):
+        check_batch(rd.coriolis_matrix, model, ("q", "v"))
+        check_batch(rd.christoffel_symbols, model, ("q",))
+
+
+@pytest.mark.parametrize("fn, names", [(rd.coriolis_matrix, ("q", "v")), (rd.christoffel_symbols, ("q",))],
+                         ids=["coriolis_matrix", "christoffel_symbols"])
+def test_bad_input(fn, names):
+    check_input_validation(fn, names)
