@@ -223,46 +223,69 @@ def _floating_model() -> rd.Model:
     return random_model(4, seed=3, floating_base=True)
 
 
-def check_input_validation(call, names) -> None:
-    """Bad input to ``call(model, check_finite=..., **arrays)`` (arrays named by ``names``):
+INPUT_CHECKS = ("shapes", "nonfinite", "unchecked_nonfinite", "quaternion")
 
-    * wrong last dimension, a scalar, or batches that do not broadcast: ValueError naming
-      the argument, the expected and the received shape;
-    * NaN or Inf: ValueError naming the argument, unless ``check_finite=False``;
-    * a quaternion far from unit norm (or zero): ValueError; a near-unit one is normalised.
+
+def check_input_validation(call, names, aspect: str) -> None:
+    """Bad input to ``call(model, check_finite=..., **arrays)`` (arrays named by ``names``),
+    one ``aspect`` of :data:`INPUT_CHECKS` at a time, single states and batches:
+
+    * ``shapes``: wrong last dimension, a scalar, or batches that do not broadcast: ValueError
+      naming the argument, the expected and the received shape;
+    * ``nonfinite``: NaN or Inf: ValueError naming the argument;
+    * ``unchecked_nonfinite``: no exception with ``check_finite=False``;
+    * ``quaternion``: one far from unit norm (or zero): ValueError; near-unit: normalised.
     """
+    assert aspect in INPUT_CHECKS
     model = _floating_model()
     q, v, a = states(model, "bad-input")
     good = {k: {"q": q, "v": v, "a": a, "tau": a}[k] for k in names}
     size = {k: model.nq if k == "q" else model.nv for k in names}
+
+    def variants(name, value, index):
+        """The state with ``name[index] = value``, alone and as element 1 of a batch of 3."""
+        one = good[name].copy()
+        one[index] = value
+        yield {**good, name: one}
+        yield {**{k: np.stack([x] * 3) for k, x in good.items()}, name: np.stack([good[name], one, good[name]])}
+
+    def unperturbed(arrays):
+        return call(model, **{k: np.broadcast_to(good[k], x.shape) for k, x in arrays.items()})
+
+    if aspect == "quaternion":
+        if "q" not in names:
+            return
+        for factor in (1.5, 0.5, 0.0):
+            for arrays in variants("q", q[3:7] * factor, slice(3, 7)):
+                with pytest.raises(ValueError, match=r"\bq\b.* quaternion of free joint 'root_joint'"):
+                    call(model, **arrays)
+        for factor in (1 + 5e-4, 1 - 5e-4):
+            for arrays in variants("q", q[3:7] * factor, slice(3, 7)):
+                assert_rel(call(model, **arrays), unperturbed(arrays), 1e-12, f"quaternion scaled by {factor}")
+        return
     for name in names:
         n = size[name]
-        for bad in (np.zeros(n + 1), np.zeros((3, n - 1)), np.float64(1.0)):
-            with pytest.raises(ValueError) as err:
-                call(model, **{**good, name: bad})
-            msg = str(err.value)
-            assert re.match(rf"{name}\b", msg), msg
-            assert f"(..., {n})" in msg and str(np.shape(bad)) in msg, msg
-        if len(names) > 1:
-            other = next(k for k in names if k != name)
-            with pytest.raises(ValueError, match="broadcast") as err:
-                call(model, **{**good, name: np.stack([good[name]] * 2), other: np.stack([good[other]] * 3)})
-            assert str((2, size[name])) in str(err.value) and str((3, size[other])) in str(err.value)
+        if aspect == "shapes":
+            for bad in (np.zeros(n + 1), np.zeros((3, n - 1)), np.float64(1.0)):
+                with pytest.raises(ValueError) as err:
+                    call(model, **{**good, name: bad})
+                msg = str(err.value)
+                assert re.match(rf"{name}\b", msg), msg
+                assert f"(..., {n})" in msg and str(np.shape(bad)) in msg, msg
+            if len(names) > 1:
+                other = next(k for k in names if k != name)
+                with pytest.raises(ValueError, match="broadcast") as err:
+                    call(model, **{**good, name: np.stack([good[name]] * 2), other: np.stack([good[other]] * 3)})
+                assert str((2, size[name])) in str(err.value) and str((3, size[other])) in str(err.value)
+            continue
         for value in (np.nan, np.inf, -np.inf):
-            bad = good[name].copy()
-            bad[-1] = value
-            with pytest.raises(ValueError, match=rf"\b{name}\b.* NaN or Inf"):
-                call(model, **{**good, name: bad})
-            out = np.asarray(call(model, **{**good, name: bad}, check_finite=False))
-            assert out.shape == np.shape(call(model, **good))
-    if "q" not in names:
-        return
-    for factor in (1.5, 0.5, 0.0):
-        bad = q.copy()
-        bad[3:7] *= factor
-        with pytest.raises(ValueError, match=r"\bq\b.* quaternion of free joint 'root_joint'"):
-            call(model, **{**good, "q": bad})
-    for factor in (1 + 5e-4, 1 - 5e-4):
-        near = q.copy()
-        near[3:7] *= factor
-        assert_rel(call(model, **{**good, "q": near}), call(model, **good), 1e-12, f"quaternion scaled by {factor}")
+            for arrays in variants(name, value, -1):
+                if aspect == "nonfinite":
+                    with pytest.raises(ValueError, match=rf"\b{name}\b.* NaN or Inf"):
+                        call(model, **arrays)
+                else:
+                    out = np.asarray(call(model, **arrays, check_finite=False))
+                    assert out.shape == np.shape(unperturbed(arrays))
+
+
+input_checks = pytest.mark.parametrize("aspect", INPUT_CHECKS)

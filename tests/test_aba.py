@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (F_EXT_FRAMES, assert_rel, check_batch, check_input_validation, random_model, random_models,
-                     rng_for, states, with_friction_and_armature)
+from helpers import (F_EXT_FRAMES, assert_rel, check_batch, check_input_validation, input_checks,
+                     random_model, random_models, rng_for, states, with_friction_and_armature)
 
 
 @random_models
@@ -91,5 +91,6 @@ def test_batch():
     check_batch(rd.aba, random_model(4, seed=22), ("q", "v", "tau"))
 
 
-def test_bad_input():
-    check_input_validation(rd.aba, ("q", "v", "tau"))
+@input_checks
+def test_bad_input(aspect):
+    check_input_validation(rd.aba, ("q", "v", "tau"), aspect)

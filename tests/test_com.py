@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (assert_rel, check_batch, check_input_validation, columns_by_differences, random_model,
-                     random_models, states)
+from helpers import (assert_rel, check_batch, check_input_validation, input_checks, columns_by_differences,
+                     random_model, random_models, states)
 
 
 def com_from_poses(model, q):
@@ -74,5 +74,6 @@ def test_batch():
 
 
 @pytest.mark.parametrize("fn", [rd.center_of_mass, rd.com_jacobian], ids=["center_of_mass", "com_jacobian"])
-def test_bad_input(fn):
-    check_input_validation(fn, ("q",))
+@input_checks
+def test_bad_input(fn, aspect):
+    check_input_validation(fn, ("q",), aspect)

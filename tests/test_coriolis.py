@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, columns_by_differences,
-                     directional_derivative, fixed_base_models, planar_2r, planar_2r_terms, random_model,
-                     random_models, rng_for, states)
+from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks,
+                     columns_by_differences, directional_derivative, fixed_base_models, planar_2r,
+                     planar_2r_terms, random_model, random_models, rng_for, states)
 
 
 @random_models
@@ -78,5 +78,6 @@ def test_batch():
 
 @pytest.mark.parametrize("fn, names", [(rd.coriolis_matrix, ("q", "v")), (rd.christoffel_symbols, ("q",))],
                          ids=["coriolis_matrix", "christoffel_symbols"])
-def test_bad_input(fn, names):
-    check_input_validation(fn, names)
+@input_checks
+def test_bad_input(fn, names, aspect):
+    check_input_validation(fn, names, aspect)

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, planar_2r, planar_2r_terms,
-                     random_model, random_models, rng_for, states, unit, with_friction_and_armature)
+from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, planar_2r,
+                     planar_2r_terms, random_model, random_models, rng_for, states, unit,
+                     with_friction_and_armature)
 
 
 @random_models
@@ -69,5 +70,6 @@ def test_batch():
     check_batch(rd.crba, random_model(3, seed=32), ("q",))
 
 
-def test_bad_input():
-    check_input_validation(rd.crba, ("q",))
+@input_checks
+def test_bad_input(aspect):
+    check_input_validation(rd.crba, ("q",), aspect)

@@ -8,8 +8,9 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (assert_rel, check_batch, check_input_validation, columns_by_differences, configuration_rate,
-                     directional_derivative, fixed_base_models, random_model, random_models, rk4, rng_for, states)
+from helpers import (assert_rel, check_batch, check_input_validation, input_checks, columns_by_differences,
+                     configuration_rate, directional_derivative, fixed_base_models, random_model,
+                     random_models, rk4, rng_for, states)
 
 
 @random_models
@@ -100,5 +101,6 @@ def test_shapes():
 
 @pytest.mark.parametrize("fn, names", [(rd.kinetic_energy, ("q", "v")), (rd.potential_energy, ("q",))],
                          ids=["kinetic_energy", "potential_energy"])
-def test_bad_input(fn, names):
-    check_input_validation(fn, names)
+@input_checks
+def test_bad_input(fn, names, aspect):
+    check_input_validation(fn, names, aspect)

@@ -11,7 +11,7 @@ import pytest
 
 import robodyn as rd
 from conftest import small_tree_builder
-from helpers import (assert_rel, check_batch, check_input_validation, columns_by_differences,
+from helpers import (assert_rel, check_batch, check_input_validation, input_checks, columns_by_differences,
                      directional_derivative, random_model, random_models, states)
 
 FRAMES = ("world", "local", "local_world_aligned")
@@ -125,6 +125,7 @@ def test_batch():
 
 
 @pytest.mark.parametrize("frame", FRAMES)
-def test_bad_input(frame):
-    check_input_validation(functools.partial(rd.jacobian, body=2, frame=frame), ("q",))
-    check_input_validation(functools.partial(rd.jacobian_dot_times_v, body=2, frame=frame), ("q", "v"))
+@input_checks
+def test_bad_input(frame, aspect):
+    check_input_validation(functools.partial(rd.jacobian, body=2, frame=frame), ("q",), aspect)
+    check_input_validation(functools.partial(rd.jacobian_dot_times_v, body=2, frame=frame), ("q", "v"), aspect)

@@ -11,8 +11,8 @@ import pytest
 import robodyn as rd
 from robodyn import joints as J
 from conftest import small_tree_builder
-from helpers import (assert_rel, check_batch, check_input_validation, quat_to_matrix, random_model, random_models,
-                     states)
+from helpers import (assert_rel, check_batch, check_input_validation, input_checks, quat_to_matrix,
+                     random_model, random_models, states)
 
 
 def _rodrigues(axis, angle):
@@ -88,5 +88,6 @@ def test_batch():
 
 @pytest.mark.parametrize("fn", [rd.forward_kinematics, functools.partial(rd.frame_pose, name="body2")],
                          ids=["forward_kinematics", "frame_pose"])
-def test_bad_input(fn):
-    check_input_validation(fn, ("q",))
+@input_checks
+def test_bad_input(fn, aspect):
+    check_input_validation(fn, ("q",), aspect)

@@ -3,14 +3,12 @@ linearity in the acceleration, the pendulum in closed form, batches and bad inpu
 
 from __future__ import annotations
 
-import re
-
 import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (F_EXT_FRAMES, G, assert_rel, check_batch, check_input_validation, pendulum, random_model, random_models,
-                     rng_for, states, with_friction_and_armature)
+from helpers import (F_EXT_FRAMES, G, assert_rel, check_batch, check_input_validation, input_checks, pendulum,
+                     random_model, random_models, rng_for, states, with_friction_and_armature)
 
 
 @random_models
@@ -117,8 +115,9 @@ def test_batch_with_external_wrenches():
             assert_rel(shared[i], rd.rnea(model, q[i], v[i], a[i], f_ext[0, 0], f_ext_frame=frame), 1e-12)
 
 
-def test_bad_input():
-    check_input_validation(rd.rnea, ("q", "v", "a"))
+@input_checks
+def test_bad_input(aspect):
+    check_input_validation(rd.rnea, ("q", "v", "a"), aspect)
 
 
 def test_bad_external_wrenches():
@@ -126,8 +125,9 @@ def test_bad_external_wrenches():
     q, v, a = states(model)
     nb = model.nbodies
     for bad in (np.zeros((nb, 3)), np.zeros((nb + 1, 6)), np.zeros(6)):
-        with pytest.raises(ValueError, match=r"^f_ext: expected shape \(\.\.\., 3, 6\), got " + re.escape(str(bad.shape))):
+        with pytest.raises(ValueError, match=r"^f_ext: expected shape \(\.\.\., 3, 6\), got ") as err:
             rd.rnea(model, q, v, a, bad)
+        assert str(err.value).endswith(str(bad.shape))
     f = np.zeros((nb, 6))
     f[1, 2] = np.nan
     with pytest.raises(ValueError, match="^f_ext: contains NaN"):

@@ -7,8 +7,9 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, planar_2r, planar_2r_terms,
-                     random_model, random_models, rng_for, states, with_friction_and_armature)
+from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, planar_2r,
+                     planar_2r_terms, random_model, random_models, rng_for, states,
+                     with_friction_and_armature)
 
 
 @random_models
@@ -67,5 +68,6 @@ def test_batch(fn, names):
 
 
 @pytest.mark.parametrize("fn, names", FUNCTIONS, ids=FUNCTION_IDS)
-def test_bad_input(fn, names):
-    check_input_validation(fn, names)
+@input_checks
+def test_bad_input(fn, names, aspect):
+    check_input_validation(fn, names, aspect)
