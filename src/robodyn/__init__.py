@@ -11,7 +11,7 @@ from .builder import ModelBuilder
 from .io import DHLink, dh_transform, from_dh, load_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
-from . import models
+from . import models, random
 from .algorithms.aba import aba
 from .algorithms.com import center_of_mass, com_jacobian
 from .algorithms.coriolis import christoffel_symbols, coriolis_matrix

@@ -127,6 +127,11 @@ def chunks(B: int) -> int:
     return max(1, min(B, numba.get_num_threads()))
 
 
+def as_batch(a: np.ndarray) -> np.ndarray:
+    """A single state (n,) as a batch of one (1, n); a batch (B, n) as it is."""
+    return a[None] if a.ndim == 1 else a
+
+
 def unflatten(out: np.ndarray, batch: tuple) -> np.ndarray:
     return out if batch == () else out.reshape(batch + out.shape[1:])
 

@@ -58,7 +58,7 @@ def invert_block(Dinv, iv, n, G, tol):
         for r in range(col + 1, n):
             if abs(G[r, col]) > best:
                 piv, best = r, abs(G[r, col])
-        if not best > tol:
+        if best <= tol:  # (NaN input with check_finite=False propagates instead)
             return False
         if piv != col:
             for c in range(2 * n):

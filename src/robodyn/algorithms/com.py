@@ -76,7 +76,7 @@ def _run(model, q, check_finite, with_jacobian, what):
         raise ValueError(f"{what}: the model has no mass: its centre of mass is undefined")
     batch, x = _inputs.states(model, q=q)
     k = model._kernel
-    Q = x["q"].reshape(-1, model.nq)
+    Q = _inputs.as_batch(x["q"])
     B = Q.shape[0]
     C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
     status = np.empty(B, dtype=np.int64)

@@ -166,7 +166,7 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     """
     batch, x = _inputs.states(model, q=q)
     nv = model.nv
-    Q = np.repeat(x["q"].reshape(-1, model.nq), nv, axis=0)
+    Q = np.repeat(_inputs.as_batch(x["q"]), nv, axis=0)
     V = np.tile(np.eye(nv), (Q.shape[0] // nv, 1))
     CC = _run(model, (Q.shape[0],), {"q": Q, "v": V}, check_finite, "christoffel_symbols").reshape(-1, nv, nv, nv)
     G = np.ascontiguousarray(CC.transpose(0, 2, 3, 1))  # (B, k, i, j) -> (B, i, j, k)

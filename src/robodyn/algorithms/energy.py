@@ -64,8 +64,8 @@ def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
 def _run(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
     k = model._kernel
-    Q = x["q"].reshape(-1, model.nq)
-    V = x["v"].reshape(-1, model.nv) if "v" in x else np.zeros((1, 0))
+    Q = _inputs.as_batch(x["q"])
+    V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2)), np.empty(B, dtype=np.int64)
     _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,

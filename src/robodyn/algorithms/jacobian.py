@@ -74,8 +74,8 @@ def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, stat
 def _run(model, x, b, check, what):
     """Flat-batch results ``(J, oR_b, op_b, acc_b, vel_b)`` for the states ``x``."""
     k = model._kernel
-    q = x["q"].reshape(-1, model.nq)
-    v = x["v"].reshape(-1, model.nv) if "v" in x else np.zeros((1, 0))
+    q = _inputs.as_batch(x["q"])
+    v = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = q.shape[0]
     JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
     ACC, VEL, status = np.empty((B, 6)), np.empty((B, 6)), np.empty(B, dtype=np.int64)

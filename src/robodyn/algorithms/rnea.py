@@ -119,8 +119,9 @@ def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
     return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
 
 
-def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea"):
-    """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``)."""
+def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None):
+    """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``); errors name
+    the arrays of ``report`` (default ``x``)."""
     k = model._kernel
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][gravity]
     q, v, a = x["q"], x["v"], x["a"]
@@ -131,7 +132,7 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
         B = q.shape[0]
         tau, status = np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
         _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status, _inputs.chunks(B))
-    _inputs.raise_for_status(model, status, x, what)
+    _inputs.raise_for_status(model, status, x if report is None else report, what)
     return _inputs.unflatten(tau, batch)
 
 

@@ -15,27 +15,28 @@ from . import _inputs
 from .rnea import run
 
 
-def _rnea_term(model, q, v, a, check_finite, gravity, armature, what) -> np.ndarray:
-    """``rnea`` without friction, with ``v``/``a`` replaced by zeros where ``None``."""
-    arrays = {"q": q, **({"v": v} if v is not None else {}), **({"a": a} if a is not None else {})}
-    batch, x = _inputs.states(model, **arrays)
-    zeros = np.zeros(batch + (model.nv,)).reshape(-1, model.nv) if batch else np.zeros(model.nv)
-    x.setdefault("v", zeros)
-    x.setdefault("a", zeros)
+def _rnea_term(model, what, check_finite, gravity, armature, given, roles) -> np.ndarray:
+    """``rnea`` without friction on the caller's arrays ``given`` (by their names), with
+    ``roles`` mapping the kernel's ``v``/``a`` to a given name (missing: zeros)."""
+    batch, x = _inputs.states(model, **given)
+    zeros = np.zeros(model.nv) if batch == () else np.zeros((x["q"].shape[0], model.nv))
+    kin = {"q": x["q"], **{role: x[name] if name else zeros for role, name in roles.items()}}
     F, fcode = _inputs.body_wrenches(model, None, batch, "local")
-    return run(model, batch, x, F, fcode, check_finite, gravity=gravity, friction=False, armature=armature, what=what)
+    return run(model, batch, kin, F, fcode, check_finite, gravity=gravity, friction=False, armature=armature,
+               what=what, report=x)
 
 
 def gravity(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Generalised gravity ``g(q)`` (..., nv): the joint forces that hold the robot still."""
-    return _rnea_term(model, q, None, None, check_finite, True, False, "gravity")
+    return _rnea_term(model, "gravity", check_finite, True, False, {"q": q}, {"v": None, "a": None})
 
 
 def nonlinear_effects(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """``C(q, v) v + g(q)`` (..., nv), the Coriolis, centrifugal and gravity forces."""
-    return _rnea_term(model, q, v, None, check_finite, True, False, "nonlinear_effects")
+    return _rnea_term(model, "nonlinear_effects", check_finite, True, False, {"q": q, "v": v}, {"v": "v", "a": None})
 
 
 def generalized_momentum(model, q, v, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Generalised momentum ``M(q) v`` (..., nv), O(n) (``armature`` as in :func:`robodyn.crba`)."""
-    return _rnea_term(model, q, None, v, check_finite, False, armature, "generalized_momentum")
+    return _rnea_term(model, "generalized_momentum", check_finite, False, armature, {"q": q, "v": v},
+                      {"v": None, "a": "v"})
