@@ -166,3 +166,68 @@ def test_bad_table_shape_and_arguments():
         rd.from_dh(_table(), convention="craig")
     with pytest.raises(ValueError, match=r"base: expected shape \(4, 4\), got \(3, 3\)"):
         rd.from_dh(_table(), base=np.eye(3))
+
+
+# -- the same robot in both conventions ---------------------------------------------------
+
+
+def _rot_x(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _standard_and_modified(seed):
+    """A 5-link table (revolute and prismatic) in standard DH, and the same robot in modified DH.
+
+    Modified frame i is standard frame i-1 moved by ``Rz(theta_i) Tz(d_i)``, and standard frame i
+    is modified frame i moved by ``Tx(a_i) Rx(alpha_i)``: the modified row i takes
+    ``a_{i-1}, alpha_{i-1}`` and each link's centre of mass and inertia are re-expressed with
+    ``Tx(a_i) Rx(alpha_i)``.
+    """
+    rng = np.random.default_rng(seed)
+    std, mod = [], []
+    prev_a, prev_alpha = 0.0, 0.0
+    for i in range(5):
+        joint = "prismatic" if i == 2 else "revolute"
+        a, alpha, d, offset, theta = rng.uniform(-0.5, 0.5), rng.uniform(-np.pi, np.pi), rng.uniform(-0.3, 0.3), \
+            rng.uniform(-1, 1), rng.uniform(-1, 1)
+        mass = rng.uniform(0.5, 3.0)
+        com = rng.uniform(-0.2, 0.2, 3)
+        d2 = rng.uniform(0.01, 0.1, 3)  # second moments along the axes: a valid rigid body
+        inertia = np.diag([d2[1] + d2[2], d2[0] + d2[2], d2[0] + d2[1]])
+        std.append(rd.DHLink(a=a, alpha=alpha, d=d, offset=offset, joint=joint, theta=theta, mass=mass, com=com,
+                             inertia=inertia))
+        R = _rot_x(alpha)
+        mod.append(rd.DHLink(a=prev_a, alpha=prev_alpha, d=d, offset=offset, joint=joint, theta=theta, mass=mass,
+                             com=R @ com + np.array([a, 0.0, 0.0]), inertia=R @ inertia @ R.T))
+        prev_a, prev_alpha = a, alpha
+    return std, mod
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_standard_and_modified_tables_give_the_same_dynamics(seed):
+    std, mod = _standard_and_modified(seed)
+    ms, mm = rd.from_dh(std, "standard"), rd.from_dh(mod, "modified")
+    rng = np.random.default_rng(seed + 10)
+    q, v, a = rng.uniform(-2, 2, (3, 5))
+    for fn, args in ((rd.rnea, (q, v, a)), (rd.aba, (q, v, a)), (rd.crba, (q,)), (rd.gravity, (q,)),
+                     (rd.coriolis_matrix, (q, v)), (rd.kinetic_energy, (q, v)), (rd.potential_energy, (q,))):
+        ref = fn(ms, *args)
+        np.testing.assert_allclose(fn(mm, *args), ref, rtol=1e-10, atol=1e-10 * max(1.0, np.abs(ref).max()))
+    # and the frames agree: standard frame i is modified frame i moved by Tx(a_i) Rx(alpha_i)
+    for i in range(1, 6):
+        post = rd.dh_transform(rd.DHLink(a=std[i - 1].a, alpha=std[i - 1].alpha, d=0.0), 0.0, "modified")
+        np.testing.assert_allclose(rd.frame_pose(ms, q, f"frame{i}"), rd.frame_pose(mm, q, f"frame{i}") @ post,
+                                   atol=1e-12)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_frame_poses_are_the_dh_product(convention):
+    std, mod = _standard_and_modified(5)
+    links = std if convention == "standard" else mod
+    model = rd.from_dh(links, convention)
+    q = np.random.default_rng(3).uniform(-2, 2, 5)
+    T = np.eye(4)
+    for i, (link, qi) in enumerate(zip(links, q), start=1):
+        T = T @ rd.dh_transform(link, qi, convention)
+        np.testing.assert_allclose(rd.frame_pose(model, q, f"frame{i}"), T, atol=1e-12)

@@ -17,14 +17,7 @@ from ..spatial import dot6, inertia_mul
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
 from .kinematics import poses_checked
-from .rnea import motion_pass
-
-
-@kernel
-def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
-            np.empty(6), np.zeros(nv), np.zeros(3))
+from .rnea import motion_pass, motion_workspace
 
 
 @kernel
@@ -56,7 +49,7 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
 def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
+        ws = motion_workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
             status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
 

@@ -24,16 +24,9 @@ from ..spatial import motion_act
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
 from .kinematics import poses_checked
-from .rnea import motion_pass
+from .rnea import motion_pass, motion_workspace
 
 FRAMES = ("world", "local", "local_world_aligned")
-
-
-@kernel
-def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
-            np.empty(6), np.zeros(nv), np.zeros(3))
 
 
 @kernel
@@ -65,7 +58,7 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
 def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
+        ws = motion_workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
             status[s] = jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s],
                                      OP[s], ACC[s], VEL[s], ws)

@@ -34,6 +34,15 @@ def workspace(nb):
             np.empty(6), np.empty(6), np.empty(6))
 
 
+@kernel
+def motion_workspace(nb, nv):
+    """Workspace of a velocity/acceleration pass at ``qdd = 0`` without gravity (used by the
+    Jacobian derivative and the energies): placements, world poses, motion, zeros."""
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
+            np.empty(6), np.zeros(nv), np.zeros(3))
+
+
 @inline
 def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
     """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the

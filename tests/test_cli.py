@@ -1,0 +1,108 @@
+"""The command line: info, demo and bench on built-in robots and URDF files, and its errors."""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.cli import main, sample_state
+
+
+def run(capsys, *argv):
+    code = main(list(argv))
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def test_info_builtin(capsys):
+    code, out, _ = run(capsys, "info", "puma560")
+    assert code == 0
+    assert "Model 'puma560': nq=6, nv=6" in out
+    for k in range(1, 7):
+        assert f"joint{k}" in out
+    assert "Inertial parameters per body" in out and "Joint data" in out
+
+
+def test_info_list(capsys):
+    code, out, _ = run(capsys, "info", "--list")
+    assert code == 0
+    assert [line.split()[0] for line in out.strip().splitlines()] == rd.models.names()
+
+
+def test_info_urdf(capsys, tmp_path):
+    urdf = tmp_path / "arm.urdf"
+    urdf.write_text("""<robot name="arm">
+      <link name="base"/>
+      <link name="l1"><inertial><mass value="2"/><inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+      <joint name="j1" type="revolute"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/>
+        <limit lower="-1" upper="1" effort="5" velocity="2"/></joint>
+    </robot>""")
+    code, out, _ = run(capsys, "info", str(urdf))
+    assert code == 0 and "Model 'arm': nq=1, nv=1" in out and "j1" in out
+    code, out, _ = run(capsys, "info", str(urdf), "--floating-base")
+    assert code == 0 and "nq=8, nv=7" in out and "root_joint" in out
+
+
+def test_demo_numbers_are_the_library_numbers(capsys):
+    code, out, _ = run(capsys, "demo", "planar_2r")
+    assert code == 0
+    model = rd.models.load("planar_2r")
+    q, v, a = sample_state(model, 0)
+    tau = rd.rnea(model, q, v, a, friction=False, armature=False)
+    g = rd.gravity(model, q)
+    rows = [line.split() for line in out.splitlines() if re.match(r"\s+joint\d", line)]
+    assert len(rows) == 2
+    for k, row in enumerate(rows):
+        inertial, coriolis, grav, total = map(float, row[1:5])
+        assert total == pytest.approx(tau[k], abs=1e-4)
+        assert grav == pytest.approx(g[k], abs=1e-4)
+        assert inertial + coriolis + grav == pytest.approx(total, abs=3e-4)
+    residuals = [float(x) for x in re.findall(r"= ([0-9.e+-]+)$", out, re.M)]
+    assert residuals and max(residuals) < 1e-9
+
+
+def test_demo_default_is_panda(capsys):
+    code, out, _ = run(capsys, "demo")
+    assert code == 0 and "robodyn demo on 'panda'" in out and "Mass matrix" in out
+
+
+def test_bench_without_comparison(capsys):
+    code, out, _ = run(capsys, "bench", "pendulum", "--batch", "50", "--no-compare")
+    assert code == 0
+    for name in ("rnea", "aba", "crba", "coriolis_matrix", "rnea (batch)"):
+        assert re.search(rf"^\s+{re.escape(name)}\s+\d+\.\d+", out, re.M), name
+
+
+def test_bench_compares_with_pinocchio(capsys):
+    code, out, _ = run(capsys, "bench", "double_pendulum", "--batch", "50")
+    assert code == 0
+    row = next(line for line in out.splitlines() if line.strip().startswith("rnea "))
+    robodyn_us, pin_us, ratio = map(float, row.split()[1:4])
+    assert ratio == pytest.approx(robodyn_us / pin_us, rel=0.01)
+
+
+def test_to_pinocchio_matches(capsys):
+    import pinocchio as pin
+
+    from robodyn.bench import to_pinocchio
+    from robodyn.random import random_model, random_state
+
+    for floating in (False, True):
+        model = random_model(6, seed=4, floating_base=floating)
+        pm = to_pinocchio(model)
+        q, v, a = random_state(model, np.random.default_rng(0))
+        np.testing.assert_allclose(pin.rnea(pm, pm.createData(), q, v, a), rd.rnea(model, q, v, a), rtol=1e-10, atol=1e-10)
+
+
+@pytest.mark.parametrize("argv, message", [
+    (("info", "no_such_robot"), "unknown model 'no_such_robot'"),
+    (("demo", "/nonexistent/robot.urdf"), "cannot read"),
+    (("demo", "panda", "--floating-base"), "--floating-base applies to URDF files"),
+])
+def test_errors_exit_2_with_a_message(capsys, argv, message):
+    code, _, err = run(capsys, *argv)
+    assert code == 2
+    assert message in err
