@@ -1,7 +1,8 @@
 """The joint table: every joint type, its dimensions, motion subspace and transform.
 
 Adding a joint type is a local change: a code, a row in ``NQ``/``NV``, its motion subspace
-in :func:`motion_subspace` and its transform in :func:`joint_transform`. Every joint type
+in :func:`motion_subspace`, and its transform in :func:`body_placement` (with constants
+precomputed by :func:`joint_constants`). Every joint type
 has a motion subspace ``S`` that is constant in the child frame, so the joint's velocity
 is ``v_J = S qd`` and its bias acceleration ``c_J = Sdot qd`` is zero (RBDA section 4.4).
 
@@ -19,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import inline
-from .spatial import rotation_axis_angle, rotation_from_quaternion
+from .spatial import rotation_from_quaternion
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -45,31 +46,62 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
 QUAT_TOL = 1e-3
 
 
+# Layout of a body's row in the kernels' ``body`` array (see ``Model._pack``).
+ROW_XTREE_R, ROW_XTREE_P, ROW_AXIS, ROW_INERTIA, ROW_JOINT = 0, 9, 12, 15, 25
+ROW_SIZE = ROW_JOINT + 27
+
+
+def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray) -> np.ndarray:
+    """Constants (27,) that make :func:`body_placement` cheap for a joint type.
+
+    Revolute, with Rodrigues' formula ``Rot(a, q) = a a^T + cos q (1 - a a^T) + sin q [a]x``:
+    ``R_tree Rot(a, q) = C + cos q A + sin q B`` with ``C = (R_tree a) a^T``,
+    ``A = R_tree - C`` and ``B = R_tree [a]x`` (row-major, in this order).
+    Prismatic: ``R_tree a`` (the joint's direction in the parent frame) first.
+    """
+    out = np.zeros(27)
+    if jtype == REVOLUTE:
+        C = np.outer(R_tree @ axis, axis)
+        ax = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        out[0:9], out[9:18], out[18:27] = C.ravel(), (R_tree - C).ravel(), (R_tree @ ax).ravel()
+    elif jtype == PRISMATIC:
+        out[0:3] = R_tree @ axis
+    return out
+
+
 @inline
-def joint_transform(jtype, axis, q, iq, R, p):
-    """Placement ``(R, p)`` of the child frame in the joint frame at configuration ``q``.
+def body_placement(jtype, row, q, iq, R, p, Rj):
+    """Placement ``(R, p)`` of a body in its parent, ``X_tree * X_J(q)``, from the body's
+    kernel row (``Model._pack``); ``Rj`` is a 3 x 3 workspace.
 
     Returns False when a free joint's quaternion is farther than ``QUAT_TOL`` from unit norm
     (a near-unit quaternion is normalised).
     """
     if jtype == REVOLUTE:
-        rotation_axis_angle(axis, q[iq], R)
-        p[0] = 0.0
-        p[1] = 0.0
-        p[2] = 0.0
-    elif jtype == PRISMATIC:
+        c = np.cos(q[iq])
+        s = np.sin(q[iq])
         for r in range(3):
-            for c in range(3):
-                R[r, c] = 1.0 if r == c else 0.0
-            p[r] = axis[r] * q[iq]
-    else:  # FREE
-        n = np.sqrt(q[iq + 3] ** 2 + q[iq + 4] ** 2 + q[iq + 5] ** 2 + q[iq + 6] ** 2)
-        if not abs(n - 1.0) <= QUAT_TOL:
-            return False
-        rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, R)
-        p[0] = q[iq]
-        p[1] = q[iq + 1]
-        p[2] = q[iq + 2]
+            p[r] = row[ROW_XTREE_P + r]
+            for k in range(3):
+                j = ROW_JOINT + 3 * r + k
+                R[r, k] = row[j] + c * row[j + 9] + s * row[j + 18]
+        return True
+    if jtype == PRISMATIC:
+        x = q[iq]
+        for r in range(3):
+            p[r] = row[ROW_XTREE_P + r] + row[ROW_JOINT + r] * x
+            for k in range(3):
+                R[r, k] = row[3 * r + k]
+        return True
+    # FREE: X_tree * (rotation of the quaternion, position)
+    n = np.sqrt(q[iq + 3] * q[iq + 3] + q[iq + 4] * q[iq + 4] + q[iq + 5] * q[iq + 5] + q[iq + 6] * q[iq + 6])
+    if not abs(n - 1.0) <= QUAT_TOL:
+        return False
+    rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, Rj)
+    for r in range(3):
+        p[r] = row[9 + r] + row[3 * r] * q[iq] + row[3 * r + 1] * q[iq + 1] + row[3 * r + 2] * q[iq + 2]
+        for k in range(3):
+            R[r, k] = row[3 * r] * Rj[0, k] + row[3 * r + 1] * Rj[1, k] + row[3 * r + 2] * Rj[2, k]
     return True
 
 

@@ -333,7 +333,8 @@ class Model:
         """Arrays handed to the compiled kernels (few arguments, contiguous, read-only).
 
         ``ints`` (nb, 5): parent, joint type, idx_q, idx_v, nv of the joint;
-        ``body`` (nb, 25): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10);
+        ``body`` (nb, 52): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10), joint
+        constants (27, ``joints.joint_constants``);
         ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
         then armature, viscous and Coulomb friction, zeroed when switched off;
         ``params[with_gravity]`` (4,): gravity (3, or zeros) and the Coulomb smoothing;
@@ -346,11 +347,13 @@ class Model:
         ints[:, 2] = self.idx_q
         ints[:, 3] = self.idx_v
         ints[:, 4] = J.NV[self.joint_type] if nb else 0
-        body = np.zeros((nb, 25))
+        body = np.zeros((nb, J.ROW_SIZE))
         body[:, 0:9] = self.X_tree_R.reshape(nb, 9)
         body[:, 9:12] = self.X_tree_p
         body[:, 12:15] = self.joint_axis
         body[:, 15:25] = self.inertia
+        for i in range(nb):
+            body[i, J.ROW_JOINT:] = J.joint_constants(int(self.joint_type[i]), self.joint_axis[i], self.X_tree_R[i])
         full = np.zeros((nv, 9))
         for i in range(nb):
             k = self.idx_v[i]

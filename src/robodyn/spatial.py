@@ -36,24 +36,6 @@ def cross3(a, b, out):
 
 
 @inline
-def rotation_axis_angle(axis, angle, R):
-    """Rodrigues' formula: rotation by ``angle`` about the unit ``axis``."""
-    x, y, z = axis[0], axis[1], axis[2]
-    c = np.cos(angle)
-    s = np.sin(angle)
-    t = 1.0 - c
-    R[0, 0] = t * x * x + c
-    R[0, 1] = t * x * y - s * z
-    R[0, 2] = t * x * z + s * y
-    R[1, 0] = t * x * y + s * z
-    R[1, 1] = t * y * y + c
-    R[1, 2] = t * y * z - s * x
-    R[2, 0] = t * x * z - s * y
-    R[2, 1] = t * y * z + s * x
-    R[2, 2] = t * z * z + c
-
-
-@inline
 def rotation_from_quaternion(qx, qy, qz, qw, R):
     """Rotation matrix of the unit quaternion ``(qx, qy, qz, qw)`` (scalar last)."""
     R[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)

@@ -14,7 +14,7 @@ import numpy as np
 from numba import prange
 
 from .._jit import inline, kernel, parallel
-from ..joints import joint_transform
+from ..joints import body_placement
 from ..spatial import compose, motion_act
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
@@ -27,13 +27,8 @@ def placements(ints, body, q, liR, lip, Rj, pj):
     Returns False when a free joint's quaternion is not of unit norm (see ``joints``).
     """
     for i in range(ints.shape[0]):
-        if not joint_transform(ints[i, 1], body[i, 12:15], q, ints[i, 2], Rj, pj):
+        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
             return False
-        for r in range(3):
-            lip[i, r] = body[i, 9 + r] + body[i, 3 * r] * pj[0] + body[i, 3 * r + 1] * pj[1] + body[i, 3 * r + 2] * pj[2]
-            for c in range(3):
-                liR[i, r, c] = (body[i, 3 * r] * Rj[0, c] + body[i, 3 * r + 1] * Rj[1, c]
-                                + body[i, 3 * r + 2] * Rj[2, c])
     return True
 
 
