@@ -1,7 +1,12 @@
 """The compilation settings of every kernel, in one place.
 
-``kernel``: a compiled function, cached on disk. ``inline``: a small helper inlined into its
-callers. ``parallel``: a batch driver whose ``prange`` loop runs on all threads.
+``kernel``: a compiled function that may allocate (workspaces, single-state drivers), cached
+on disk. ``parallel``: a batch driver whose ``prange`` loop runs on all threads.
+``core``: an algorithm's per-state body, and ``inline``: a small helper inlined into its
+callers; both run without Numba's reference counting (``_nrt=False``), which would
+otherwise add atomic increments and decrements of every array passed to a helper (a
+several-fold slowdown of the inner loops). They must not allocate: workspaces come from
+their callers.
 
 ``error_model="numpy"`` lets divisions by zero give inf/nan instead of raising (the kernels
 check their inputs and pivots themselves); ``fastmath`` allows fused multiply-add and
@@ -14,5 +19,6 @@ FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 _BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH)
 
 kernel = njit(**_BASE)
-inline = njit(inline="always", **_BASE)
 parallel = njit(parallel=True, **_BASE)
+core = njit(_nrt=False, **_BASE)
+inline = njit(inline="always", _nrt=False, **_BASE)

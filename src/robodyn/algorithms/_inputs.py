@@ -20,10 +20,19 @@ import numpy as np
 
 from .._jit import inline
 from .. import joints as J
+from ..joints import NQ
 
 OK = 0
 NONFINITE = -1
 BAD_QUATERNION = -2
+WRONG_SIZE = -3
+
+
+@inline
+def nq_of(ints):
+    """Length of the configuration vector of the model whose kernel table is ``ints``."""
+    nb = ints.shape[0]
+    return 0 if nb == 0 else ints[nb - 1, 2] + NQ[ints[nb - 1, 1]]
 
 
 @inline
@@ -45,6 +54,15 @@ def _as_float(name: str, x) -> np.ndarray:
 
 
 _F8 = np.dtype(np.float64)
+
+
+def vectors(*xs) -> bool:
+    """True when every argument is a 1-D float64 ndarray: the single-state fast path, where the
+    kernel itself checks the sizes (status ``WRONG_SIZE``) and values."""
+    for x in xs:
+        if not (type(x) is np.ndarray and x.ndim == 1 and x.dtype is _F8):
+            return False
+    return True
 
 
 def states(model, **arrays):
@@ -86,7 +104,7 @@ def states(model, **arrays):
     return batch, out
 
 
-_WRENCH_FRAMES = {"local": 0, "world": 1, "local_world_aligned": 2}
+WRENCH_FRAMES = {"local": 0, "world": 1, "local_world_aligned": 2}
 
 
 def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, int]:
@@ -97,10 +115,10 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
     (body frame, torque about the body origin), 1 ``"world"`` (world axes, torque about the
     world origin), 2 ``"local_world_aligned"`` (world axes, torque about the body origin).
     """
-    if f_ext is None and frame in _WRENCH_FRAMES:
+    if f_ext is None and frame in WRENCH_FRAMES:
         zero = model._kernel["zero_wrench"]
         return (zero if batch == () else zero[None]), -1
-    codes = _WRENCH_FRAMES
+    codes = WRENCH_FRAMES
     if frame not in codes:
         raise ValueError(f"f_ext_frame must be one of {sorted(codes)}, got {frame!r}")
     nb = model.nbodies
@@ -153,6 +171,8 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
         code = int(status[bad[0]])
     if code == OK:
         return 0
+    if code == WRONG_SIZE:
+        raise AssertionError("sizes are checked before the kernels run")
     if code == NONFINITE:
         for name, a in arrays.items():
             idx = np.argwhere(~np.isfinite(a))

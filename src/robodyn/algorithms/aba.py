@@ -22,12 +22,12 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import inline, kernel, parallel
+from .._jit import core, inline, kernel, parallel
 from ..joints import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
                        matvec6, motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
 from .kinematics import placements, world_placements
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
@@ -78,13 +78,15 @@ def invert_block(Dinv, iv, n, G, tol):
     return True
 
 
-@kernel
+@core
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
     ``i + 1`` when the articulated inertia of body ``i`` is singular."""
     (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
      B3, PB, UD, G, t1, t2, Ia) = ws
-    nb = ints.shape[0]
+    nb, nv = ints.shape[0], dofs.shape[0]
+    if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and tau.shape[0] == nv):
+        return WRONG_SIZE
     if check and not (finite(q) and finite(v) and finite(tau)):
         return NONFINITE
     if not placements(ints, body, q, liR, lip, Rj, pj):
@@ -217,9 +219,14 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
     leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
     """
+    k = model._kernel
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, tau):
+        qdd = np.empty(model.nv)  # fast path for one state: the kernel checks sizes and values
+        if _aba_single(k["ints"], k["body"], k["dofs"][bool(friction), bool(armature)], k["params"][True], q, v,
+                       tau, k["zero_wrench"], -1, check_finite, qdd) == OK:
+            return qdd
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    k = model._kernel
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
     if batch == ():
         qdd = np.empty(model.nv)

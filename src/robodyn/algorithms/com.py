@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, parallel
+from .._jit import core, kernel, parallel
 from . import _inputs
 from .crba import world_inertias
 from ._inputs import OK
@@ -26,7 +26,7 @@ def workspace(nb, nv):
             np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)))
 
 
-@kernel
+@core
 def com_one(ints, body, dofs, q, check, c, Jc, ws):
     """Centre of mass ``c`` (3,) and, if ``Jc`` has columns, its Jacobian (3, nv)."""
     liR, lip, oR, op, Rj, pj, oS, Ic = ws

@@ -24,11 +24,11 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import inline, kernel, parallel
+from .._jit import core, inline, kernel, parallel
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
-from ._inputs import NONFINITE, OK, finite
+from ._inputs import NONFINITE, OK, WRONG_SIZE, finite, nq_of
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -67,10 +67,12 @@ def body_B(theta, V, K, Vx, h, B):
         B[o_r + 2, o_c + 1] -= 0.5 * a0
 
 
-@kernel
+@core
 def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
+    if not (q.shape[0] == nq_of(ints) and v.shape[0] == dofs.shape[0]):
+        return WRONG_SIZE
     if check and not finite(v):
         return NONFINITE
     status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
@@ -150,6 +152,11 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     ``Mdot - 2C`` is skew-symmetric and ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel
     symbols of :func:`christoffel_symbols`. Reference: Echeandia and Wensing (2021).
     """
+    if _inputs.vectors(q, v):
+        k = model._kernel  # fast path for one state: the kernel checks sizes and values
+        C = np.empty((model.nv, model.nv))
+        if _coriolis_single(k["ints"], k["body"], k["dofs"][False, False], q, v, check_finite, C) == OK:
+            return C
     batch, x = _inputs.states(model, q=q, v=v)
     return _inputs.unflatten(_run(model, batch, x, check_finite, "coriolis_matrix"), batch)
 

@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import inline, kernel, parallel
+from .._jit import core, inline, kernel, parallel
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
-from ._inputs import OK
+from ._inputs import OK, WRONG_SIZE, nq_of
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -36,9 +36,11 @@ def world_inertias(ints, body, oR, op, Ic):
         inertia_act(oR[i], op[i], body[i, 15:25], Ic[i])
 
 
-@kernel
+@core
 def crba_one(ints, body, dofs, q, check, M, ws):
     liR, lip, oR, op, Rj, pj, oS, Ic, F = ws
+    if q.shape[0] != nq_of(ints):
+        return WRONG_SIZE
     status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
@@ -86,8 +88,12 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.nd
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
-    batch, x = _inputs.states(model, q=q)
     k = model._kernel
+    if _inputs.vectors(q):
+        M = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
+        if _crba_single(k["ints"], k["body"], k["dofs"][False, bool(armature)], q, check_finite, M) == OK:
+            return M
+    batch, x = _inputs.states(model, q=q)
     dofs, q = k["dofs"][(False, bool(armature))], x["q"]
     if batch == ():
         M = np.empty((model.nv, model.nv))

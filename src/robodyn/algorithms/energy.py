@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, parallel
+from .._jit import core, kernel, parallel
 from ..spatial import dot6, inertia_mul
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
@@ -20,7 +20,7 @@ from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
 
 
-@kernel
+@core
 def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic energy (when ``v`` has entries), ``out[1]`` potential energy."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import kernel, parallel
+from .._jit import core, kernel, parallel
 from ..spatial import motion_act
 from . import _inputs
 from ._inputs import NONFINITE, OK, finite
@@ -29,7 +29,7 @@ from .rnea import motion_pass, motion_workspace
 FRAMES = ("world", "local", "local_world_aligned")
 
 
-@kernel
+@core
 def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws):
     """World Jacobian ``J`` (6, nv) of body ``b``, its pose, and (when ``v`` has entries) the
     body-frame velocity and acceleration of ``b`` at ``qdd = 0`` without gravity."""
@@ -45,12 +45,15 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
         for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
             motion_act(oR[j], op[j], dofs[k, :6], J[:, k])
         j = ints[j, 0]
-    oRb[:, :] = oR[b]
-    opb[:] = op[b]
+    for r in range(3):
+        opb[r] = op[b, r]
+        for c in range(3):
+            oRb[r, c] = oR[b, r, c]
     if v.shape[0] > 0:
         motion_pass(ints, dofs, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
-        acc_b[:] = acc[b]
-        vel_b[:] = vel[b]
+        for r in range(6):
+            acc_b[r] = acc[b, r]
+            vel_b[r] = vel[b, r]
     return OK
 
 

@@ -38,8 +38,10 @@ def world_placements(ints, liR, lip, oR, op):
     for i in range(ints.shape[0]):
         par = ints[i, 0]
         if par < 0:
-            oR[i, :, :] = liR[i]
-            op[i, :] = lip[i]
+            for r in range(3):
+                op[i, r] = lip[i, r]
+                for c in range(3):
+                    oR[i, r, c] = liR[i, r, c]
         else:
             compose(oR[par], op[par], liR[i], lip[i], oR[i], op[i])
 

@@ -19,11 +19,11 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from .._jit import inline, kernel, parallel
+from .._jit import core, inline, kernel, parallel
 from ..joints import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
 from .kinematics import placements, world_placements
 
 
@@ -71,14 +71,16 @@ def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
             acc[i, r] += t1[r]
 
 
-@kernel
+@core
 def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
 
     ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
     """
     liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
-    nb = ints.shape[0]
+    nb, nv = ints.shape[0], dofs.shape[0]
+    if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and a.shape[0] == nv):
+        return WRONG_SIZE
     if check and not (finite(q) and finite(v) and finite(a)):
         return NONFINITE
     if not placements(ints, body, q, liR, lip, Rj, pj):
@@ -169,6 +171,12 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     nonlinear_effects(q, v)``, ``rnea(q, v, a) == crba(q) a + nonlinear_effects(q, v)`` without
     friction. Reference: Featherstone, RBDA (2008), Table 5.1.
     """
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a):
+        k = model._kernel  # fast path for one state: the kernel checks sizes and values
+        tau = np.empty(model.nv)
+        if _rnea_single(k["ints"], k["body"], k["dofs"][bool(friction), bool(armature)], k["params"][True], q, v,
+                        a, k["zero_wrench"], -1, check_finite, tau) == OK:
+            return tau
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)
