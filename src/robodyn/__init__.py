@@ -12,16 +12,34 @@ from .io import DHLink, dh_transform, from_dh, load_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
-from .algorithms.aba import aba
-from .algorithms.com import center_of_mass, com_jacobian
-from .algorithms.coriolis import christoffel_symbols, coriolis_matrix
-from .algorithms.crba import crba
-from .algorithms.energy import kinetic_energy, potential_energy
-from .algorithms.jacobian import jacobian, jacobian_dot_times_v
-from .algorithms.kinematics import forward_kinematics, frame_pose
-from .algorithms.rnea import rnea
-from .algorithms.terms import generalized_momentum, gravity, nonlinear_effects
-from .warmup import warmup
+
+# The algorithms are imported on first use (PEP 562), so that `import robodyn` stays fast.
+_LAZY = {
+    "aba": "aba", "center_of_mass": "com", "com_jacobian": "com", "christoffel_symbols": "coriolis",
+    "coriolis_matrix": "coriolis", "crba": "crba", "kinetic_energy": "energy", "potential_energy": "energy",
+    "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
+    "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
+    "nonlinear_effects": "terms",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        import importlib
+
+        value = getattr(importlib.import_module(f".algorithms.{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name == "warmup":
+        from .warmup import warmup
+
+        return warmup
+    raise AttributeError(f"module 'robodyn' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY) | {"warmup"})
+
 
 __version__ = "0.1.0"
 
