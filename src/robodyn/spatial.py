@@ -276,14 +276,14 @@ def congruence_to_parent(R, p, A, B, PB, out):
     for blk in range(3):
         o_r = 0 if blk < 2 else 3
         o_c = 0 if blk == 0 else 3
-        # B[blk] = R A_blk R^T
+        # PB = A_blk R^T, then B[blk] = R PB
+        for k in range(3):
+            a0, a1, a2 = A[o_r + k, o_c], A[o_r + k, o_c + 1], A[o_r + k, o_c + 2]
+            for c in range(3):
+                PB[k, c] = a0 * R[c, 0] + a1 * R[c, 1] + a2 * R[c, 2]
         for r in range(3):
             for c in range(3):
-                s = 0.0
-                for k in range(3):
-                    t = A[o_r + k, o_c] * R[c, 0] + A[o_r + k, o_c + 1] * R[c, 1] + A[o_r + k, o_c + 2] * R[c, 2]
-                    s += R[r, k] * t
-                B[blk, r, c] = s
+                B[blk, r, c] = R[r, 0] * PB[0, c] + R[r, 1] * PB[1, c] + R[r, 2] * PB[2, c]
     p0, p1, p2 = p[0], p[1], p[2]
     # columns of B11 P: (B11 P)[:, c] = B11 [p]x e_c
     for r in range(3):

@@ -133,7 +133,11 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
                 for r in range(6):
                     d += dofs[j, r] * U[k, r]
                 Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
-        if not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+        if n == 1:  # the common case: D is a scalar
+            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:  # (NaN with check_finite=False propagates)
+                return i + 1
+            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
+        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
             return i + 1
         if par >= 0:
             # UD = U Dinv (6 x n), Ia = IA - UD U^T, pa = pA + Ia c + UD u
