@@ -162,7 +162,7 @@ def format_table(rows: list[Timing], other: str = "pinocchio") -> str:
     lines = [f"  {'call':<26} {'robodyn us':>11} {other + ' us':>14} {'ratio':>7}"]
     for t in rows:
         o = "" if t.other_us is None else f"{t.other_us:14.3f}"
-        r = "" if t.ratio is None else f"{t.ratio:7.2f}"
+        r = "" if t.ratio is None else f"{t.ratio:7.3g}"
         lines.append(f"  {t.name:<26} {t.robodyn_us:11.3f} {o:>14} {r:>7}")
     return "\n".join(lines)
 
