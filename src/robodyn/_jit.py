@@ -8,7 +8,8 @@ otherwise add atomic increments and decrements of every array passed to a helper
 several-fold slowdown of the inner loops). They must not allocate: workspaces come from
 their callers.
 
-``error_model="numpy"`` lets divisions by zero give inf/nan instead of raising (the kernels
+All release the GIL (``nogil``), so Python threads run them concurrently (they share no
+state: every call allocates its own workspace). ``error_model="numpy"`` lets divisions by zero give inf/nan instead of raising (the kernels
 check their inputs and pivots themselves); ``fastmath`` allows fused multiply-add and
 reassociation but keeps NaN/Inf semantics, so the finiteness checks stay exact.
 """
@@ -16,7 +17,7 @@ reassociation but keeps NaN/Inf semantics, so the finiteness checks stay exact.
 from numba import njit
 
 FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
-_BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH)
+_BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH, nogil=True)
 
 kernel = njit(**_BASE)
 parallel = njit(parallel=True, **_BASE)
