@@ -30,7 +30,7 @@ def workspace(nb, nv):
 def com_one(ints, body, dofs, q, check, c, Jc, ws):
     """Centre of mass ``c`` (3,) and, if ``Jc`` has columns, its Jacobian (3, nv)."""
     liR, lip, oR, op, Rj, pj, oS, Ic = ws
-    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    status = poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
     world_inertias(ints, body, oR, op, Ic)

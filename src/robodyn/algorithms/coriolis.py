@@ -28,7 +28,7 @@ from .._jit import core, inline, kernel, parallel
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
-from ._inputs import NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from ._inputs import OK, WRONG_SIZE, nq_of
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -73,9 +73,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     nb = ints.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == dofs.shape[0]):
         return WRONG_SIZE
-    if check and not finite(v):
-        return NONFINITE
-    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
     world_motion_subspace(ints, dofs, oR, op, oS)

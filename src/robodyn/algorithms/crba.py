@@ -41,7 +41,7 @@ def crba_one(ints, body, dofs, q, check, M, ws):
     liR, lip, oR, op, Rj, pj, oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
-    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    status = poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
     world_motion_subspace(ints, dofs, oR, op, oS)

@@ -15,7 +15,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from ..spatial import dot6, inertia_mul
 from . import _inputs
-from ._inputs import NONFINITE, OK, finite
+from ._inputs import OK
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
 
@@ -24,9 +24,7 @@ from .rnea import motion_pass, motion_workspace
 def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic energy (when ``v`` has entries), ``out[1]`` potential energy."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
-    if check and not finite(v):
-        return NONFINITE
-    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
     T, U = 0.0, 0.0

@@ -22,7 +22,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from ..spatial import motion_act
 from . import _inputs
-from ._inputs import NONFINITE, OK, finite
+from ._inputs import OK
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
 
@@ -34,9 +34,7 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
     """World Jacobian ``J`` (6, nv) of body ``b``, its pose, and (when ``v`` has entries) the
     body-frame velocity and acceleration of ``b`` at ``qdd = 0`` without gravity."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, a0, zero_a, zero_g = ws
-    if check and not finite(v):
-        return NONFINITE
-    status = poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
     if status != OK:
         return status
     J[:, :] = 0.0

@@ -55,9 +55,10 @@ def world_motion_subspace(ints, dofs, oR, op, oS):
 
 
 @inline
-def poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op):
-    """Local and world placements of every body, with the input checks; returns a status."""
-    if check and not finite(q):
+def poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op):
+    """Local and world placements of every body, after the value checks of ``q`` and ``v``
+    (``v`` may be empty); returns a status (see ``_inputs``)."""
+    if check and not (finite(q) and finite(v)):
         return NONFINITE
     if not placements(ints, body, q, liR, lip, Rj, pj):
         return BAD_QUATERNION
@@ -73,7 +74,7 @@ def workspace(nb):
 @kernel
 def _fk_single(ints, body, q, oR, op, check):
     liR, lip, Rj, pj = workspace(ints.shape[0])
-    return poses_checked(ints, body, q, check, liR, lip, Rj, pj, oR, op)
+    return poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
 
 
 @parallel
@@ -82,7 +83,7 @@ def _fk_batch(ints, body, Q, OR, OP, check, status, nchunk):
     for c in prange(nchunk):
         liR, lip, Rj, pj = workspace(ints.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = poses_checked(ints, body, Q[s], check, liR, lip, Rj, pj, OR[s], OP[s])
+            status[s] = poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
 
 
 def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
