@@ -73,9 +73,7 @@ def random_robot(draw):
 @FUZZ
 @given(random_robot())
 def test_random_robots_load_or_raise_model_error(text):
-    model = load(text)
-    if model is not None:
-        assert model.nbodies >= 0 and model.nq >= model.nv - model.nbodies
+    load(text)  # any exception other than ModelError fails the test
 
 
 MUTATIONS = ("delete_attribute", "nan", "huge", "swap_names", "duplicate_element", "delete_element",

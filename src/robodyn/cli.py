@@ -63,12 +63,14 @@ def cmd_info(args) -> int:
 
 def sample_state(model, seed: int = 0):
     """A reproducible sample state: mid-range joint angles, moderate speeds and accelerations."""
+    from .joints import FREE
     from .random import random_configuration
 
     rng = np.random.default_rng(seed)
-    q = random_configuration(model, rng) * 0.5
-    if model.floating_base:
-        q = random_configuration(model, rng)
+    q = random_configuration(model, rng)
+    for i in range(model.nbodies):  # joint angles in [-pi/2, pi/2]; a free joint stays as drawn
+        if model.joint_type[i] != FREE:
+            q[model.idx_q[i]] *= 0.5
     v = rng.uniform(-1.0, 1.0, model.nv)
     a = rng.uniform(-2.0, 2.0, model.nv)
     return q, v, a
