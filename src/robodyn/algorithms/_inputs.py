@@ -8,9 +8,11 @@ expected shape and the received one.
 The value checks run inside the compiled kernels, where they cost nanoseconds: each kernel
 returns a status per state (``OK``, ``NONFINITE`` for NaN/Inf in an input, ``BAD_QUATERNION``
 for a free joint's quaternion farther than ``joints.QUAT_TOL`` from unit norm — near-unit
-ones are normalised — or ``i + 1`` for a failure at body ``i``), and :func:`raise_for_status`
+ones are normalised —, ``NONFINITE_RESULT`` when the inputs are finite but the result
+overflowed, or ``i + 1`` for a failure at body ``i``), and :func:`raise_for_status`
 turns a failure into a ``ValueError`` that says what and where. ``check_finite=False`` skips
-the NaN/Inf check (for hot loops with trusted input).
+the NaN/Inf checks of inputs and results (for hot loops with trusted input). No public function
+returns NaN or Inf from finite inputs: it raises instead.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ OK = 0
 NONFINITE = -1
 BAD_QUATERNION = -2
 WRONG_SIZE = -3
+NONFINITE_RESULT = -4
 
 
 @inline
@@ -42,6 +45,22 @@ def finite(x):
         if not np.isfinite(x[k]):
             return False
     return True
+
+
+@inline
+def finite2(x):
+    """True when every entry of the 2-D array ``x`` is finite."""
+    for r in range(x.shape[0]):
+        if not finite(x[r]):
+            return False
+    return True
+
+
+@inline
+def result_status(check, ok):
+    """The status of a computed result: ``OK``, or ``NONFINITE_RESULT`` when the value checks
+    are on and ``ok`` (the result's finiteness) is False."""
+    return NONFINITE_RESULT if check and not ok else OK
 
 
 def _as_float(name: str, x) -> np.ndarray:
@@ -180,6 +199,12 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
                 raise ValueError(f"{what}: {name} contains NaN or Inf (first at index {tuple(idx[0].tolist())}); "
                                  "pass check_finite=False to skip this check")
         raise AssertionError("kernel reported a non-finite input that is not there")
+    if code == NONFINITE_RESULT:
+        big = max((float(np.abs(a).max()) for a in arrays.values() if np.size(a)), default=0.0)
+        raise ValueError(
+            f"{what}: the result is not finite although every input is (largest input magnitude {big:.3g}): "
+            "the computation overflowed or divided by zero; check the scale of the inputs and the model's "
+            "masses and inertias")
     if code == BAD_QUATERNION:
         q = arrays["q"]
         for i in np.flatnonzero(model.joint_type == J.FREE):

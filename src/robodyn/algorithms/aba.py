@@ -27,7 +27,7 @@ from ..joints import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
                        matvec6, motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status
 from .kinematics import placements, world_placements
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
@@ -188,7 +188,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
         for k in range(iv, iv + n):
             for r in range(6):
                 acc[i, r] += dofs[k, r] * qdd[k]
-    return OK
+    return result_status(check, finite(qdd))
 
 
 @parallel

@@ -16,7 +16,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from . import _inputs
 from .crba import world_inertias
-from ._inputs import OK
+from ._inputs import OK, finite, finite2, result_status
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -59,7 +59,7 @@ def com_one(ints, body, dofs, q, check, c, Jc, ws):
         c[r] /= mass
         for k in range(Jc.shape[1]):
             Jc[r, k] /= mass
-    return OK
+    return result_status(check, finite(c) and finite2(Jc))
 
 
 @parallel

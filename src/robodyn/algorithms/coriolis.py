@@ -28,7 +28,7 @@ from .._jit import core, inline, kernel, parallel
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
-from ._inputs import OK, WRONG_SIZE, nq_of
+from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -112,7 +112,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
             for r in range(6):
                 for c in range(6):
                     Bc[par, r, c] += Bc[i, r, c]
-    return OK
+    return result_status(check, finite2(C))
 
 
 @parallel

@@ -19,7 +19,7 @@ from numba import prange
 from .._jit import core, inline, kernel, parallel
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
-from ._inputs import OK, WRONG_SIZE, nq_of
+from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -62,7 +62,7 @@ def crba_one(ints, body, dofs, q, check, M, ws):
         if par >= 0:
             for r in range(10):
                 Ic[par, r] += Ic[i, r]
-    return OK
+    return result_status(check, finite2(M))
 
 
 @parallel

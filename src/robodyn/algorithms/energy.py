@@ -15,7 +15,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from ..spatial import dot6, inertia_mul
 from . import _inputs
-from ._inputs import OK
+from ._inputs import OK, finite, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
 
@@ -40,7 +40,7 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
             U -= grav[r] * mc
     out[0] = T
     out[1] = U
-    return OK
+    return result_status(check, finite(out))
 
 
 @parallel

@@ -22,7 +22,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from ..spatial import motion_act
 from . import _inputs
-from ._inputs import OK
+from ._inputs import OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
 
@@ -52,7 +52,7 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
         for r in range(6):
             acc_b[r] = acc[b, r]
             vel_b[r] = vel[b, r]
-    return OK
+    return result_status(check, finite2(J) and (v.shape[0] == 0 or finite(acc_b)))
 
 
 @parallel

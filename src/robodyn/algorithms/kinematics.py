@@ -17,7 +17,7 @@ from .._jit import inline, kernel, parallel
 from ..joints import body_placement
 from ..spatial import compose, motion_act
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite, finite2, result_status
 
 
 @inline
@@ -57,13 +57,14 @@ def world_motion_subspace(ints, dofs, oR, op, oS):
 @inline
 def poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op):
     """Local and world placements of every body, after the value checks of ``q`` and ``v``
-    (``v`` may be empty); returns a status (see ``_inputs``)."""
+    (``v`` may be empty); returns a status (see ``_inputs``): positions that overflow (huge
+    prismatic coordinates) are a ``NONFINITE_RESULT``."""
     if check and not (finite(q) and finite(v)):
         return NONFINITE
     if not placements(ints, body, q, liR, lip, Rj, pj):
         return BAD_QUATERNION
     world_placements(ints, liR, lip, oR, op)
-    return OK
+    return result_status(check, finite2(op))
 
 
 @kernel

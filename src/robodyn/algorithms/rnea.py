@@ -23,7 +23,7 @@ from .._jit import core, inline, kernel, parallel
 from ..joints import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status
 from .kinematics import placements, world_placements
 
 
@@ -112,7 +112,7 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
             force_act(liR[i], lip[i], f[i], t1)
             for r in range(6):
                 f[par, r] += t1[r]
-    return OK
+    return result_status(check, finite(tau))
 
 
 @parallel
