@@ -23,8 +23,7 @@ import numpy as np
 
 from . import joints as J
 from .errors import RobodynWarning
-from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from
-from .spatial import inertia_act
+from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from, inertial_parameters_in_parent
 
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "fixed": None}
 
@@ -240,9 +239,7 @@ class ModelBuilder:
             b, R, p = place[link]
             if b < 0:
                 continue  # carried by the fixed world
-            out = np.empty(10)
-            inertia_act(R, p, self._links[link].theta, out)
-            theta[b] += out
+            theta[b] += inertial_parameters_in_parent(R, p, self._links[link].theta)
         for i, t in enumerate(theta):
             self._check_physical(t, f"{self.source}: body {names[i]!r} (with the links merged into it)")
 

@@ -1,8 +1,8 @@
 """The joint table: every joint type, its dimensions, motion subspace and transform.
 
 Adding a joint type is a local change: a code, a row in ``NQ``/``NV``, its motion subspace
-in :func:`motion_subspace`, and its transform in :func:`body_placement` (with constants
-precomputed by :func:`joint_constants`). Every joint type
+in :func:`motion_subspace`, and its transform in ``joint_kernels.body_placement`` (with
+constants precomputed by :func:`joint_constants`). Every joint type
 has a motion subspace ``S`` that is constant in the child frame, so the joint's velocity
 is ``v_J = S qd`` and its bias acceleration ``c_J = Sdot qd`` is zero (RBDA section 4.4).
 
@@ -19,8 +19,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._jit import inline
-from .spatial import rotation_from_quaternion
 
 REVOLUTE = 0
 PRISMATIC = 1
@@ -52,7 +50,7 @@ ROW_SIZE = ROW_JOINT + 27
 
 
 def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray) -> np.ndarray:
-    """Constants (27,) that make :func:`body_placement` cheap for a joint type.
+    """Constants (27,) that make ``joint_kernels.body_placement`` cheap for a joint type.
 
     Revolute, with Rodrigues' formula ``Rot(a, q) = a a^T + cos q (1 - a a^T) + sin q [a]x``:
     ``R_tree Rot(a, q) = C + cos q A + sin q B`` with ``C = (R_tree a) a^T``,
@@ -67,51 +65,3 @@ def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray) -> np.ndar
     elif jtype == PRISMATIC:
         out[0:3] = R_tree @ axis
     return out
-
-
-@inline
-def body_placement(jtype, row, q, iq, R, p, Rj):
-    """Placement ``(R, p)`` of a body in its parent, ``X_tree * X_J(q)``, from the body's
-    kernel row (``Model._pack``); ``Rj`` is a 3 x 3 workspace.
-
-    Returns False when a free joint's quaternion is farther than ``QUAT_TOL`` from unit norm
-    (a near-unit quaternion is normalised).
-    """
-    if jtype == REVOLUTE:
-        c = np.cos(q[iq])
-        s = np.sin(q[iq])
-        for r in range(3):
-            p[r] = row[ROW_XTREE_P + r]
-            for k in range(3):
-                j = ROW_JOINT + 3 * r + k
-                R[r, k] = row[j] + c * row[j + 9] + s * row[j + 18]
-        return True
-    if jtype == PRISMATIC:
-        x = q[iq]
-        for r in range(3):
-            p[r] = row[ROW_XTREE_P + r] + row[ROW_JOINT + r] * x
-            for k in range(3):
-                R[r, k] = row[3 * r + k]
-        return True
-    # FREE: X_tree * (rotation of the quaternion, position)
-    n = np.sqrt(q[iq + 3] * q[iq + 3] + q[iq + 4] * q[iq + 4] + q[iq + 5] * q[iq + 5] + q[iq + 6] * q[iq + 6])
-    if not abs(n - 1.0) <= QUAT_TOL:
-        return False
-    rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, Rj)
-    for r in range(3):
-        p[r] = row[9 + r] + row[3 * r] * q[iq] + row[3 * r + 1] * q[iq + 1] + row[3 * r + 2] * q[iq + 2]
-        for k in range(3):
-            R[r, k] = row[3 * r] * Rj[0, k] + row[3 * r + 1] * Rj[1, k] + row[3 * r + 2] * Rj[2, k]
-    return True
-
-
-@inline
-def friction_torque(dofs, eps, v, k):
-    """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
-
-    ``dofs[k, 6:9] = [armature, b (viscous), Fc (Coulomb)]``; ``sgn`` is ``sign`` when
-    ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
-    """
-    vk = v[k]
-    s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
-    return dofs[k, 7] * vk + dofs[k, 8] * s

@@ -57,6 +57,21 @@ def inertia_about_origin(theta) -> np.ndarray:
     return np.array([[t[4], t[5], t[7]], [t[5], t[6], t[8]], [t[7], t[8], t[9]]], dtype=float)
 
 
+def inertial_parameters_in_parent(R, p, theta) -> np.ndarray:
+    """Inertial parameters of a body expressed in the frame where it is placed at ``(R, p)``.
+
+    ``h' = R h + m p``;
+    ``I' = R I R^T - p h_r^T - h_r p^T + 2 (p . h_r) 1 - m p p^T + m |p|^2 1`` with
+    ``h_r = R h`` (the parallel-axis theorem without dividing by the mass).
+    """
+    R, p, t = np.asarray(R, dtype=float), np.asarray(p, dtype=float), np.asarray(theta, dtype=float)
+    m, hr = t[0], R @ t[1:4]
+    I = R @ inertia_about_origin(t) @ R.T - np.outer(p, hr) - np.outer(hr, p) \
+        + (2.0 * p @ hr + m * (p @ p)) * np.eye(3) - m * np.outer(p, p)
+    h = hr + m * p
+    return np.array([m, h[0], h[1], h[2], I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
 def check_inertial_parameters(theta, where: str) -> None:
     """Raise :class:`ModelError` unless ``theta`` is a physically consistent rigid body.
 
@@ -338,7 +353,10 @@ class Model:
         ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
         then armature, viscous and Coulomb friction, zeroed when switched off;
         ``params[with_gravity]`` (4,): gravity (3, or zeros) and the Coulomb smoothing;
-        ``zero_wrench`` (nb, 6): no external wrench.
+        ``zero_wrench`` (nb, 6): no external wrench;
+        ``packed[(friction, armature)]``: ``body``, that ``dofs``, ``params[True]`` and
+        ``zero_wrench`` raveled into one array, for the single-state fast paths, where each
+        argument costs Numba's dispatcher about 0.1 us (``_inputs.unpack`` takes it apart).
         """
         nb, nv = self.nbodies, self.nv
         ints = np.zeros((nb, 5), dtype=np.int64)
@@ -369,8 +387,11 @@ class Model:
                 dofs[(friction, armature)] = d
         params = {True: np.array([*self.gravity, self.coulomb_smoothing]),
                   False: np.array([0.0, 0.0, 0.0, self.coulomb_smoothing])}
-        out = dict(ints=ints, body=body, dofs=dofs, params=params, zero_wrench=np.zeros((nb, 6)))
-        for a in (ints, body, *dofs.values(), *params.values(), out["zero_wrench"]):
+        zero_wrench = np.zeros((nb, 6))
+        packed = {key: np.concatenate([body.ravel(), d.ravel(), params[True], zero_wrench.ravel()])
+                  for key, d in dofs.items()}
+        out = dict(ints=ints, body=body, dofs=dofs, params=params, zero_wrench=zero_wrench, packed=packed)
+        for a in (ints, body, *dofs.values(), *params.values(), zero_wrench, *packed.values()):
             a.flags.writeable = False
         return out
 

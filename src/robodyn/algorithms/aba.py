@@ -23,11 +23,11 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, inline, kernel, parallel
-from ..joints import friction_torque
+from ..joint_kernels import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
                        matvec6, motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import placements, world_placements
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
@@ -207,6 +207,13 @@ def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
                    workspace(ints.shape[0], dofs.shape[0]))
 
 
+@kernel
+def _aba_packed(ints, packed, q, v, tau, check, qdd):
+    """One state without external wrenches, the model in one array (the fast path)."""
+    body, dofs, params, zero = unpack(ints, packed)
+    return aba_one(ints, body, dofs, params, q, v, tau, zero, -1, check, qdd, workspace(ints.shape[0], dofs.shape[0]))
+
+
 def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
         armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Forward dynamics: the acceleration produced by joint forces ``tau`` at ``(q, v)``.
@@ -226,8 +233,7 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     k = model._kernel
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, tau):
         qdd = np.empty(model.nv)  # fast path for one state: the kernel checks sizes and values
-        if _aba_single(k["ints"], k["body"], k["dofs"][bool(friction), bool(armature)], k["params"][True], q, v,
-                       tau, k["zero_wrench"], -1, check_finite, qdd) == OK:
+        if _aba_packed(k["ints"], k["packed"][bool(friction), bool(armature)], q, v, tau, check_finite, qdd) == OK:
             return qdd
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)

@@ -14,7 +14,7 @@ import numpy as np
 from numba import prange
 
 from .._jit import inline, kernel, parallel
-from ..joints import body_placement
+from ..joint_kernels import body_placement
 from ..spatial import compose, motion_act
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite, finite2, result_status

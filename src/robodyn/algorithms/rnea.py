@@ -20,10 +20,10 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, inline, kernel, parallel
-from ..joints import friction_torque
+from ..joint_kernels import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import placements, world_placements
 
 
@@ -130,6 +130,13 @@ def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
     return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
 
 
+@kernel
+def _rnea_packed(ints, packed, q, v, a, check, tau):
+    """One state without external wrenches, the model in one array (the fast path)."""
+    body, dofs, params, zero = unpack(ints, packed)
+    return rnea_one(ints, body, dofs, params, q, v, a, zero, -1, check, tau, workspace(ints.shape[0]))
+
+
 def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None):
     """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``); errors name
     the arrays of ``report`` (default ``x``)."""
@@ -174,8 +181,7 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a):
         k = model._kernel  # fast path for one state: the kernel checks sizes and values
         tau = np.empty(model.nv)
-        if _rnea_single(k["ints"], k["body"], k["dofs"][bool(friction), bool(armature)], k["params"][True], q, v,
-                        a, k["zero_wrench"], -1, check_finite, tau) == OK:
+        if _rnea_packed(k["ints"], k["packed"][bool(friction), bool(armature)], q, v, a, check_finite, tau) == OK:
             return tau
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
