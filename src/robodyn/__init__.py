@@ -22,9 +22,9 @@ _LAZY = {
     "nonlinear_effects": "terms",
     "hybrid_dynamics": "hybrid", "inverse_mass_matrix": "minv", "constrained_dynamics": "constrained",
     "ConstrainedDynamics": "constrained", "PointConstraint": "constrained", "WeldConstraint": "constrained",
-    "LoopConstraint": "constrained", "CouplingConstraint": "constrained", "task_space_inertia": "task_space",
-    "dynamically_consistent_inverse": "task_space", "task_space_dynamics": "task_space",
-    "TaskSpaceDynamics": "task_space",
+    "LoopConstraint": "constrained", "DistanceConstraint": "constrained", "CouplingConstraint": "constrained",
+    "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
+    "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
 }
 
 
@@ -54,6 +54,6 @@ __all__ = [
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",
-    "WeldConstraint", "LoopConstraint", "CouplingConstraint", "task_space_inertia", "dynamically_consistent_inverse",
-    "task_space_dynamics", "TaskSpaceDynamics",
+    "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
+    "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
 ]

@@ -1,5 +1,5 @@
 """Constrained dynamics: accelerations and constraint forces of a tree with contacts, welds,
-closed loops and coupled joints, from the KKT system solved by a Schur complement.
+closed loops, rods and coupled joints, from the KKT system solved by a Schur complement.
 
     [[M, J_c^T], [J_c, 0]] [a; -lambda] = [tau - h; gamma]
 
@@ -34,8 +34,7 @@ import numpy as np
 from .. import joints as Jt
 from . import _inputs
 from .crba import crba
-from .jacobian import jacobian, jacobian_dot_times_v
-from .kinematics import frame_pose
+from .jacobian import _frame as jacobian_frame, _run as jacobian_pass
 from .rnea import rnea
 
 # Eigenvalues of the Schur complement below this fraction of the largest are dropped.
@@ -50,44 +49,65 @@ def _vector3(name: str, x) -> np.ndarray:
     return a
 
 
-def _body_name(name: str, body):
+def _body_name(name: str, body, world: bool = False):
+    if world and body is None:
+        return None
     if not isinstance(body, (str, int, np.integer)) or isinstance(body, bool):
         raise ValueError(f"{name}: expected a link or frame name or a body index, got {body!r}")
     return body if isinstance(body, str) else int(body)
 
 
-class _PointKinematics(NamedTuple):
-    """A point fixed on a body, world axes, flat batch: position (B, 3), Jacobian (B, 3, nv)
-    of its velocity and ``Jdot v`` (B, 3), its acceleration at ``qdd = 0``."""
+class FrameKinematics(NamedTuple):
+    """A frame or point fixed on a body, flat batch of B states, world axes: orientation
+    ``R`` (B, 3, 3) and position ``p`` (B, 3); Jacobians ``J_lin`` (B, 3, nv) of the velocity
+    of the point and ``J_ang`` (B, 3, nv) of the angular velocity; ``acc_lin`` (B, 3) and
+    ``acc_ang`` (B, 3) the point's classical and the angular acceleration at ``qdd = 0``
+    (``Jdot v``)."""
+    R: np.ndarray
     p: np.ndarray
-    J: np.ndarray
-    Jdv: np.ndarray
+    J_lin: np.ndarray
+    J_ang: np.ndarray
+    acc_lin: np.ndarray
+    acc_ang: np.ndarray
 
 
-def frame_kinematics(model, q, v, body):
-    """World pose (B, 4, 4), Jacobian (B, 6, nv) and ``Jdot v`` (B, 6) of a link/frame name or
-    body index, ``"local_world_aligned"`` coordinates, for flat batches ``q``, ``v``."""
-    name = model.link_names[model.body_index(body)] if not isinstance(body, str) else body
-    T = frame_pose(model, q, name, check_finite=False)
-    J = jacobian(model, q, name, "local_world_aligned", check_finite=False)
-    Jdv = jacobian_dot_times_v(model, q, v, name, "local_world_aligned", check_finite=False)
-    return T, J, Jdv
+def _skew(x: np.ndarray) -> np.ndarray:
+    """``[x]x`` (B, 3, 3) of vectors (B, 3)."""
+    S = np.zeros(x.shape[:-1] + (3, 3))
+    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -x[..., 2], x[..., 1], -x[..., 0]
+    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = x[..., 2], -x[..., 1], x[..., 0]
+    return S
 
 
-def point_kinematics(model, q, v, body, point) -> _PointKinematics:
-    """Position, velocity Jacobian and ``Jdot v`` of the point ``point`` (3,), given in the
-    coordinates of the link/frame ``body``, for flat batches ``q`` (B, nq), ``v`` (B, nv).
+def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return (A @ x[..., None])[..., 0]
 
-    ``p = p_f + r`` with ``r = R_f point``; ``v_p = v_f + omega x r``, so
-    ``J_p = J_lin - [r]x J_ang``; ``a_p = a_f + alpha x r + omega x (omega x r)``, with ``J``
-    and ``Jdot v`` of the frame in ``"local_world_aligned"`` coordinates.
+
+def frame_kinematics(model, q, v, body, point=(0.0, 0.0, 0.0)) -> FrameKinematics:
+    """Kinematics of the point ``point`` (3,) given in the coordinates of the link/frame
+    ``body`` (name or body index; ``None``: a fixed world point), for one state ``q`` (nq,),
+    ``v`` (nv,) (then B = 1) or flat batches ``q`` (B, nq), ``v`` (B, nv).
+
+    From one pass of the Jacobian kernel (world-frame Jacobian ``oJ``, body pose ``(oR, op)``,
+    body-frame velocity ``[v_o; w]`` and acceleration ``[a_o; alpha]`` at ``qdd = 0``), with
+    ``r`` the point in body coordinates and ``x = op + oR r``:
+    ``J_lin = oJ_lin - [x]x oJ_ang``, ``J_ang = oJ_ang``,
+    ``acc_lin = oR (a_o + alpha x r + w x (v_o + w x r))``, ``acc_ang = oR alpha``
+    (spatial to classical acceleration, RBDA section 2.11).
     """
-    T, J, Jdv = frame_kinematics(model, q, v, body)
-    r = T[:, :3, :3] @ point
-    omega = np.einsum("bij,bj->bi", J[:, 3:], v)
-    Jp = J[:, :3] - np.cross(r[:, :, None], J[:, 3:], axis=1)
-    acc = Jdv[:, :3] + np.cross(Jdv[:, 3:], r) + np.cross(omega, np.cross(omega, r))
-    return _PointKinematics(T[:, :3, 3] + r, Jp, acc)
+    point = np.asarray(point, dtype=float)
+    B = _inputs.as_batch(q).shape[0]
+    if body is None:
+        zeros = np.zeros((B, 3, model.nv))
+        return FrameKinematics(np.broadcast_to(np.eye(3), (B, 3, 3)), np.broadcast_to(point, (B, 3)), zeros, zeros,
+                               np.zeros((B, 3)), np.zeros((B, 3)))
+    b, R_bf, p_bf = jacobian_frame(model, body)
+    r = p_bf + R_bf @ point
+    oJ, oR, op, acc, vel = jacobian_pass(model, {"q": q, "v": v}, b, False, "constrained_dynamics")
+    x = op + oR @ r
+    w, alpha = vel[:, 3:], acc[:, 3:]
+    a_body = acc[:, :3] + np.cross(alpha, r) + np.cross(w, vel[:, :3] + np.cross(w, r))
+    return FrameKinematics(oR @ R_bf, x, oJ[:, :3] - _skew(x) @ oJ[:, 3:], oJ[:, 3:], _mv(oR, a_body), _mv(oR, alpha))
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,8 +131,8 @@ class PointConstraint:
         object.__setattr__(self, "target", _vector3("PointConstraint.target", self.target))
 
     def rows(self, model, q, v):
-        pk = point_kinematics(model, q, v, self.body, self.point)
-        return pk.J, pk.Jdv, pk.p - self.target
+        k = frame_kinematics(model, q, v, self.body, self.point)
+        return k.J_lin, k.acc_lin, k.p - self.target
 
 
 @dataclass(frozen=True, eq=False)
@@ -142,9 +162,9 @@ class WeldConstraint:
         object.__setattr__(self, "target", T)
 
     def rows(self, model, q, v):
-        T, J, Jdv = frame_kinematics(model, q, v, self.body)
-        return J, Jdv, np.concatenate([T[:, :3, 3] - self.target[:3, 3],
-                                       _log_rotation(T[:, :3, :3] @ self.target[:3, :3].T)], axis=1)
+        k = frame_kinematics(model, q, v, self.body)
+        return (np.concatenate([k.J_lin, k.J_ang], axis=1), np.concatenate([k.acc_lin, k.acc_ang], axis=1),
+                np.concatenate([k.p - self.target[:3, 3], _log_rotation(k.R @ self.target[:3, :3].T)], axis=1))
 
 
 @dataclass(frozen=True, eq=False)
@@ -154,27 +174,71 @@ class LoopConstraint:
     mechanism (its out-of-plane rows are then redundant).
 
     ``point_a`` in the coordinates of ``body_a`` and ``point_b`` in those of ``body_b`` must
-    coincide. Force: ``[fx, fy, fz]`` (N) applied to ``body_a`` at the point, world axes;
+    coincide (``body_b=None``: ``point_b`` is a fixed world point). Force: ``[fx, fy, fz]`` (N) applied to ``body_a`` at the point, world axes;
     ``body_b`` receives the opposite force.
     """
     body_a: str | int
     point_a: np.ndarray
-    body_b: str | int
+    body_b: str | int | None
     point_b: np.ndarray
 
     dim = 3
 
     def __post_init__(self):
-        for side in ("a", "b"):
-            object.__setattr__(self, f"body_{side}", _body_name(f"LoopConstraint.body_{side}",
-                                                               getattr(self, f"body_{side}")))
-            object.__setattr__(self, f"point_{side}", _vector3(f"LoopConstraint.point_{side}",
-                                                               getattr(self, f"point_{side}")))
+        _two_points(self)
 
     def rows(self, model, q, v):
-        a = point_kinematics(model, q, v, self.body_a, self.point_a)
-        b = point_kinematics(model, q, v, self.body_b, self.point_b)
-        return a.J - b.J, a.Jdv - b.Jdv, a.p - b.p
+        a = frame_kinematics(model, q, v, self.body_a, self.point_a)
+        b = frame_kinematics(model, q, v, self.body_b, self.point_b)
+        return a.J_lin - b.J_lin, a.acc_lin - b.acc_lin, a.p - b.p
+
+
+@dataclass(frozen=True, eq=False)
+class DistanceConstraint:
+    """A rigid massless rod of length ``length`` (m) between two body points (1 constraint):
+    ``|p_a - p_b| = length``; ``body_b=None`` anchors the rod at the world point ``point_b``.
+
+    Position error ``phi = (|d|^2 - length^2) / (2 length)`` with ``d = p_a - p_b`` (equal to
+    ``|d| - length`` to first order), Jacobian ``d^T (J_a - J_b) / length``. Force: the rod
+    force (N) along ``d / length``, applied to ``body_a`` at ``point_a`` (positive pushes the
+    points apart, negative is tension); ``body_b`` receives the opposite force.
+    """
+    body_a: str | int
+    point_a: np.ndarray
+    body_b: str | int | None
+    point_b: np.ndarray
+    length: float
+
+    dim = 1
+
+    def __post_init__(self):
+        _two_points(self)
+        L = self.length
+        if isinstance(L, bool) or not isinstance(L, (int, float, np.integer, np.floating)) or not (np.isfinite(L) and L > 0):
+            raise ValueError(f"DistanceConstraint.length: expected a finite number > 0, got {L!r}")
+        object.__setattr__(self, "length", float(L))
+
+    def rows(self, model, q, v):
+        a = frame_kinematics(model, q, v, self.body_a, self.point_a)
+        b = frame_kinematics(model, q, v, self.body_b, self.point_b)
+        d, dJ = a.p - b.p, a.J_lin - b.J_lin
+        dv = _mv(dJ, _inputs.as_batch(v))
+        L = self.length
+        J = (d[:, None, :] @ dJ) / L
+        Jdv = (np.sum(d * (a.acc_lin - b.acc_lin), axis=1) + np.sum(dv * dv, axis=1)) / L
+        phi = (np.sum(d * d, axis=1) - L * L) / (2.0 * L)
+        return J, Jdv[:, None], phi[:, None]
+
+
+def _two_points(c) -> None:
+    """Check and freeze ``body_a``, ``point_a``, ``body_b`` (or None), ``point_b`` of ``c``."""
+    kind = type(c).__name__
+    for side in ("a", "b"):
+        object.__setattr__(c, f"body_{side}", _body_name(f"{kind}.body_{side}", getattr(c, f"body_{side}"),
+                                                         world=side == "b"))
+        object.__setattr__(c, f"point_{side}", _vector3(f"{kind}.point_{side}", getattr(c, f"point_{side}")))
+    if c.body_a == c.body_b and isinstance(c.body_a, str):
+        raise ValueError(f"{kind}: body_a and body_b are the same body {c.body_a!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -212,6 +276,7 @@ class CouplingConstraint:
 
     def rows(self, model, q, v):
         (qa, va), (qb, vb) = self._indices(model, self.joint_a), self._indices(model, self.joint_b)
+        q = _inputs.as_batch(q)
         J = np.zeros((q.shape[0], 1, model.nv))
         J[:, 0, vb] = 1.0
         J[:, 0, va] -= self.ratio
@@ -219,7 +284,7 @@ class CouplingConstraint:
         return J, np.zeros((q.shape[0], 1)), phi[:, None]
 
 
-CONSTRAINT_TYPES = (PointConstraint, WeldConstraint, LoopConstraint, CouplingConstraint)
+CONSTRAINT_TYPES = (PointConstraint, WeldConstraint, LoopConstraint, DistanceConstraint, CouplingConstraint)
 
 
 def _log_rotation(R: np.ndarray) -> np.ndarray:
@@ -240,9 +305,10 @@ class ConstrainedDynamics(NamedTuple):
 
 
 def constraint_jacobian(model, q, v, constraints: Sequence) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stacked ``(J_c, Jdot_c v, phi)`` of ``constraints`` for flat batches ``q`` (B, nq),
-    ``v`` (B, nv): (B, m, nv), (B, m), (B, m) with ``m`` the sum of their dimensions."""
-    B = q.shape[0]
+    """Stacked ``(J_c, Jdot_c v, phi)`` of ``constraints`` for one state ``q`` (nq,), ``v``
+    (nv,) (then B = 1) or flat batches ``q`` (B, nq), ``v`` (B, nv): (B, m, nv), (B, m),
+    (B, m) with ``m`` the sum of their dimensions."""
+    B = _inputs.as_batch(q).shape[0]
     if not constraints:
         return np.zeros((B, 0, model.nv)), np.zeros((B, 0)), np.zeros((B, 0))
     parts = [c.rows(model, q, v) for c in constraints]
@@ -306,7 +372,8 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
     Args:
         q: (..., nq). v, tau: (..., nv).
         constraints: a sequence of :class:`PointConstraint`, :class:`WeldConstraint`,
-            :class:`LoopConstraint`, :class:`CouplingConstraint` (or a single one).
+            :class:`LoopConstraint`, :class:`DistanceConstraint`, :class:`CouplingConstraint`
+            (or a single one).
         baumgarte: ``(alpha, beta)`` >= 0 in 1/s; ``(0, 0)`` enforces the constraints at
             acceleration level only.
         rcond: relative threshold below which eigenvalues of the Schur complement count as
@@ -331,18 +398,20 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
         for name, arr in x.items():
             if not np.all(np.isfinite(arr)):
                 raise ValueError(f"constrained_dynamics: {name} contains NaN or Inf")
-    Q, V, TAU = (_inputs.as_batch(x[k]) for k in ("q", "v", "tau"))
-    M = crba(model, Q, armature=armature, check_finite=False)
-    h = rnea(model, Q, V, np.zeros_like(V), friction=friction, armature=armature, check_finite=False)
-    Jc, Jdv, phi = constraint_jacobian(model, Q, V, constraints)
+    nv = model.nv
+    M = crba(model, x["q"], armature=armature, check_finite=False).reshape(-1, nv, nv)
+    h = rnea(model, x["q"], x["v"], np.zeros_like(x["v"]), friction=friction, armature=armature,
+             check_finite=False).reshape(-1, nv)
+    Jc, Jdv, phi = constraint_jacobian(model, x["q"], x["v"], constraints)
+    V, TAU = _inputs.as_batch(x["v"]), _inputs.as_batch(x["tau"])
     L = cholesky(model, M, "constrained_dynamics")
     LT = np.swapaxes(L, 1, 2)
     a0 = np.linalg.solve(LT, np.linalg.solve(L, (TAU - h)[..., None]))[..., 0]
     Y = np.linalg.solve(L, np.swapaxes(Jc, 1, 2))                    # L^-1 J_c^T (B, nv, m)
     S = np.swapaxes(Y, 1, 2) @ Y                                     # J_c M^-1 J_c^T
-    gamma = -Jdv - 2.0 * alpha * np.einsum("bij,bj->bi", Jc, V) - beta * beta * phi
+    gamma = -Jdv - 2.0 * alpha * _mv(Jc, V) - beta * beta * phi
     Sinv, rank = symmetric_pinv(S, rcond)
-    lam = np.einsum("bij,bj->bi", Sinv, gamma - np.einsum("bij,bj->bi", Jc, a0))
+    lam = _mv(Sinv, gamma - _mv(Jc, a0))
     a = a0 + np.linalg.solve(LT, Y @ lam[..., None])[..., 0]
     bounds = np.cumsum([0] + [c.dim for c in constraints])
     forces = tuple(_inputs.unflatten(lam[:, lo:hi], batch) if batch else lam[0, lo:hi]

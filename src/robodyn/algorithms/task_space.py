@@ -58,9 +58,9 @@ def _task(model, q, body, frame, rows, armature, check_finite, what):
     if rows not in ROWS:
         raise ValueError(f"rows must be one of {tuple(ROWS)}, got {rows!r}")
     batch, x = _inputs.states(model, q=q)
-    Q = _inputs.as_batch(x["q"])
-    J = jacobian(model, Q, body, frame, check_finite=check_finite)[:, ROWS[rows]]
-    Minv = inverse_mass_matrix(model, Q, armature=armature, check_finite=False)
+    nv = model.nv
+    J = jacobian(model, x["q"], body, frame, check_finite=check_finite).reshape(-1, 6, nv)[:, ROWS[rows]]
+    Minv = inverse_mass_matrix(model, x["q"], armature=armature, check_finite=False).reshape(-1, nv, nv)
     A = J @ Minv @ np.swapaxes(J, 1, 2)
     A = 0.5 * (A + np.swapaxes(A, 1, 2))
     w, V = np.linalg.eigh(A)
@@ -115,11 +115,11 @@ def task_space_dynamics(model, q, v, body, frame: str = "local_world_aligned", r
     if check_finite and not np.all(np.isfinite(x["v"])):
         raise ValueError("task_space_dynamics: v contains NaN or Inf")
     _, _, Minv, J, Lam = _task(model, x["q"], body, frame, rows, armature, check_finite, "task_space_dynamics")
-    Q, V = _inputs.as_batch(x["q"]), _inputs.as_batch(x["v"])
+    Q, V, nv = x["q"], x["v"], model.nv
     Jbar = Minv @ np.swapaxes(J, 1, 2) @ Lam
-    g = gravity(model, Q, check_finite=False)
-    Cv = nonlinear_effects(model, Q, V, check_finite=False) - g
-    Jdv = jacobian_dot_times_v(model, Q, V, body, frame, check_finite=False)[:, ROWS[rows]]
+    g = gravity(model, Q, check_finite=False).reshape(-1, nv)
+    Cv = nonlinear_effects(model, Q, V, check_finite=False).reshape(-1, nv) - g
+    Jdv = jacobian_dot_times_v(model, Q, V, body, frame, check_finite=False).reshape(-1, 6)[:, ROWS[rows]]
     JbarT = np.swapaxes(Jbar, 1, 2)
     mu = np.einsum("bij,bj->bi", JbarT, Cv) - np.einsum("bij,bj->bi", Lam, Jdv)
     p = np.einsum("bij,bj->bi", JbarT, g)
