@@ -67,7 +67,7 @@ def _task(model, q, body, frame, rows, armature, check_finite, what):
     bad = ~(w[:, 0] > SINGULAR_RCOND * w[:, -1])
     if np.any(bad):
         s = int(np.flatnonzero(bad)[0])
-        where = "" if batch == () else f" (batch element {np.unravel_index(s, batch)})"
+        where = "" if batch == () else f" (batch element {tuple(int(i) for i in np.unravel_index(s, batch))})"
         raise ValueError(
             f"{what}: J M^-1 J^T of {body!r} ({rows} rows, frame {frame!r}) is singular{where}: eigenvalues "
             f"{w[s].tolist()}; the frame cannot move in every task direction at this configuration (a kinematic "
