@@ -66,8 +66,10 @@ def test_batch(model):
 
 @input_checks
 def test_input_validation(aspect):
-    check_input_validation(lambda model, q, check_finite=True: rd.inverse_mass_matrix(model, q, check_finite=check_finite),
-                           ["q"], aspect)
+    def call(model, q, check_finite=True):
+        return rd.inverse_mass_matrix(model, q, check_finite=check_finite)
+
+    check_input_validation(call, ["q"], aspect)
 
 
 def test_singular_model():

@@ -11,7 +11,7 @@ constraint forces, so that ``M a = tau - h + J_c^T lambda``. With ``alpha = beta
 constraint holds at acceleration level (``J_c a + Jdot_c v = 0``); positive values make
 position and velocity errors decay as ``phi'' + 2 alpha phi' + beta^2 phi = 0``.
 
-Solution (Schur complement on ``M``, Featherstone RBDA section 8.3; Baumgarte 1972):
+Solution (Schur complement on ``M``, Featherstone RBDA chapter 8; Baumgarte 1972):
 ``M = L L^T`` (Cholesky), ``a_0 = M^-1 (tau - h)`` (the unconstrained acceleration),
 ``S = J_c M^-1 J_c^T = Y^T Y`` with ``Y = L^-1 J_c^T``, ``S lambda = gamma - J_c a_0``,
 ``a = a_0 + M^-1 J_c^T lambda``.
@@ -174,8 +174,8 @@ class LoopConstraint:
     mechanism (its out-of-plane rows are then redundant).
 
     ``point_a`` in the coordinates of ``body_a`` and ``point_b`` in those of ``body_b`` must
-    coincide (``body_b=None``: ``point_b`` is a fixed world point). Force: ``[fx, fy, fz]`` (N) applied to ``body_a`` at the point, world axes;
-    ``body_b`` receives the opposite force.
+    coincide (``body_b=None``: ``point_b`` is a fixed world point). Force: ``[fx, fy, fz]``
+    (N) applied to ``body_a`` at the point, world axes; ``body_b`` receives the opposite force.
     """
     body_a: str | int
     point_a: np.ndarray
@@ -214,7 +214,8 @@ class DistanceConstraint:
     def __post_init__(self):
         _two_points(self)
         L = self.length
-        if isinstance(L, bool) or not isinstance(L, (int, float, np.integer, np.floating)) or not (np.isfinite(L) and L > 0):
+        number = isinstance(L, (int, float, np.integer, np.floating)) and not isinstance(L, bool)
+        if not (number and np.isfinite(L) and L > 0):
             raise ValueError(f"DistanceConstraint.length: expected a finite number > 0, got {L!r}")
         object.__setattr__(self, "length", float(L))
 
@@ -385,7 +386,7 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
         ``aba(q, v, tau)``.
 
     Raises ValueError for bad shapes or values, unknown bodies or joints, and a mass matrix
-    that is not positive definite. Reference: Featherstone, RBDA (2008), section 8.3;
+    that is not positive definite. Reference: Featherstone, RBDA (2008), chapter 8;
     J. Baumgarte, "Stabilization of constraints and integrals of motion in dynamical
     systems", Comput. Methods Appl. Mech. Eng. 1 (1972).
     """

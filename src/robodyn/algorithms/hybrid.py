@@ -1,4 +1,4 @@
-"""Hybrid dynamics by the articulated-body method (RBDA section 9.2, Table 9.6), O(n).
+"""Hybrid dynamics by the articulated-body method (RBDA section 9.2), O(n).
 
 Some joints have a known (prescribed) acceleration and an unknown force, the others a known
 force and an unknown acceleration. A joint with a known acceleration moves as if rigid for
@@ -251,7 +251,7 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     Equivalences: with every entry known, ``tau == rnea(q, v, a_known)``; with none known,
     ``a == aba(q, v, tau_known)``. Raises ValueError when the articulated inertia of a body
     whose acceleration is unknown is singular. Reference: Featherstone, RBDA (2008),
-    section 9.2 and Table 9.6.
+    section 9.2.
     """
     known = known_dofs(model, known_mask)
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)

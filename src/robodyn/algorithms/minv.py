@@ -2,7 +2,7 @@
 
 ``M(q)^-1`` is the forward dynamics of unit joint forces without velocity and gravity: its
 column ``k`` is ``aba(q, 0, e_k)`` with ``g = 0``. The ABA runs once on all ``nv`` columns at
-once (Carpentier and Mansard 2018, section IV; RBDA section 7.3), the bias forces and
+once (Carpentier and Mansard 2018; RBDA section 7.3), the bias forces and
 accelerations becoming 6 x nv matrices:
 
 Pass 2 (leaves to root), with ``F_i = 0`` (6, nv) at the start:

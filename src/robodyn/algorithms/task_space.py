@@ -83,7 +83,7 @@ def task_space_inertia(model, q, body, frame: str = "local_world_aligned", rows:
     ``body``: body index or link/frame name; ``frame``: coordinates of ``J`` as in
     :func:`robodyn.jacobian`; ``rows``: ``"all"`` (m = 6, ``[linear; angular]``),
     ``"linear"`` or ``"angular"`` (m = 3). Raises ValueError where ``J M^-1 J^T`` is singular.
-    Reference: Khatib 1987, eq. (8).
+    Reference: Khatib 1987.
     """
     batch, _, _, _, Lam = _task(model, q, body, frame, rows, armature, check_finite, "task_space_inertia")
     return Lam[0] if batch == () else Lam.reshape(batch + Lam.shape[1:])
@@ -93,7 +93,7 @@ def dynamically_consistent_inverse(model, q, body, frame: str = "local_world_ali
                                    armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Dynamically consistent generalised inverse ``Jbar = M^-1 J^T Lambda`` (..., nv, m) of
     the task Jacobian (arguments as in :func:`task_space_inertia`): ``J Jbar = 1``.
-    Reference: Khatib 1987, eq. (27)."""
+    Reference: Khatib 1987."""
     batch, _, Minv, J, Lam = _task(model, q, body, frame, rows, armature, check_finite,
                                    "dynamically_consistent_inverse")
     Jbar = Minv @ np.swapaxes(J, 1, 2) @ Lam
@@ -108,7 +108,7 @@ def task_space_dynamics(model, q, v, body, frame: str = "local_world_aligned", r
     Returns :class:`TaskSpaceDynamics` ``(Lambda, mu, p, Jbar, J)`` with
     ``mu = Jbar^T C v - Lambda Jdot v`` and ``p = Jbar^T g`` (rigid-body terms, no friction).
     Joint forces ``tau = J^T F`` then give the frame the acceleration ``x'' = J a + Jdot v``
-    with ``Lambda x'' + mu + p = F``. Reference: Khatib 1987, eqs. (8)-(10); Siciliano et
+    with ``Lambda x'' + mu + p = F``. Reference: Khatib 1987; Siciliano et
     al. 2009, section 7.8.
     """
     batch, x = _inputs.states(model, q=q, v=v)
