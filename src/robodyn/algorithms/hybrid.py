@@ -254,10 +254,15 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     section 9.2.
     """
     known = known_dofs(model, known_mask)
-    batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     k = model._kernel
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
+        a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
+        if _hybrid_single(k["ints"], k["body"], dofs, params, q, v, a_known, tau_known, known, k["zero_wrench"],
+                          -1, check_finite, a, tau) == OK:
+            return a, tau
+    batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     args = (k["ints"], k["body"], dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
             check_finite)
     if batch == ():

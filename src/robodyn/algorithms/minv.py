@@ -13,6 +13,11 @@ of the identity of the joint's dofs), ``IA_p += iX_p^T (IA_i - U_i D_i^-1 U_i^T)
 Pass 3 (root to leaves), with ``A_0 = 0``: ``A_i' = iX_p A_p``,
 ``Minv[dofs of i, :] = D_i^-1 (u_i - U_i^T A_i')``, ``A_i = A_i' + S_i Minv[dofs of i, :]``.
 
+Bodies are numbered after their ancestors, so the dofs of a body's subtree all come at or
+after its own first dof ``k_i``: the columns ``< k_i`` of ``F_i`` and ``u_i`` are zero, and
+only the upper triangle (columns ``>= k_i`` of the rows of body ``i``) is computed, then
+mirrored.
+
 Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
 algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Table 7.1.
 """
@@ -66,7 +71,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                 for r in range(6):
                     d += dofs[j, r] * U[k, r]
                 Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
-            for col in range(nv):
+            for col in range(iv, nv):
                 s = 0.0
                 for r in range(6):
                     s += dofs[k, r] * F[i, r, col]
@@ -91,7 +96,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                         s -= UD[r, j] * U[iv + j, cc]
                     Ia[r, cc] = s
             congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
-            for col in range(nv):
+            for col in range(iv, nv):
                 for r in range(6):
                     s = F[i, r, col]
                     for j in range(n):
@@ -103,7 +108,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
     # Pass 3: accelerations of the unit joint forces (F now holds the body accelerations)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        for col in range(nv):
+        for col in range(iv, nv):
             if par >= 0:
                 for r in range(6):
                     t1[r] = F[par, r, col]
@@ -126,9 +131,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                 F[i, r, col] = t2[r]
     for k in range(nv):
         for col in range(k + 1, nv):
-            s = 0.5 * (Minv[k, col] + Minv[col, k])
-            Minv[k, col] = s
-            Minv[col, k] = s
+            Minv[col, k] = Minv[k, col]
     return OK
 
 
