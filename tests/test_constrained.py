@@ -289,11 +289,11 @@ def test_gear_coupling_and_weld():
 # -- bad input ---------------------------------------------------------------------------------
 def test_bad_constraint_specifications():
     with pytest.raises(ValueError, match=r"PointConstraint.point: expected 3 finite numbers"):
-        rd.PointConstraint("a", (0, 0))
+        rd.PointConstraint("a", (0, 0), (0, 0, 0))
     with pytest.raises(ValueError, match=r"PointConstraint.target: expected 3 finite numbers"):
         rd.PointConstraint("a", (0, 0, 0), (0, np.nan, 0))
     with pytest.raises(ValueError, match=r"PointConstraint.body: expected a link or frame name"):
-        rd.PointConstraint(1.5)
+        rd.PointConstraint(1.5, (0, 0, 0), (0, 0, 0))
     with pytest.raises(ValueError, match=r"WeldConstraint.target: expected a finite 4 x 4 pose"):
         rd.WeldConstraint("a", np.eye(3))
     with pytest.raises(ValueError, match=r"WeldConstraint.target: not a homogeneous transform"):
@@ -313,10 +313,10 @@ def test_bad_constraint_specifications():
 def test_bad_arguments():
     model = TREES[1]
     q, v, tau = states(model, "bad")
-    good = [rd.PointConstraint("body3")]
+    good = [rd.PointConstraint("body3", (0, 0, 0), (0, 0, 0))]
     call = rd.constrained_dynamics
     with pytest.raises(ValueError, match=r"unknown link or frame 'nope'"):
-        call(model, q, v, tau, [rd.PointConstraint("nope")])
+        call(model, q, v, tau, [rd.PointConstraint("nope", (0, 0, 0), (0, 0, 0))])
     with pytest.raises(ValueError, match=r"body index 40 out of range"):
         call(model, q, v, tau, [rd.LoopConstraint(40, (0, 0, 0), "body1", (0, 0, 0))])
     with pytest.raises(ValueError, match=r"unknown 1-dof joint 'root_joint'"):
@@ -348,4 +348,5 @@ def test_singular_mass_matrix():
     b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
     model = b.build()
     with pytest.raises(ValueError, match=r"constrained_dynamics: the mass matrix is not positive definite"):
-        rd.constrained_dynamics(model, np.zeros(2), np.zeros(2), np.zeros(2), [rd.PointConstraint("arm")])
+        rd.constrained_dynamics(model, np.zeros(2), np.zeros(2), np.zeros(2),
+                                [rd.PointConstraint("arm", (0, 0, 0), (0, 0, 0))])

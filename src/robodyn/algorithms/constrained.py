@@ -116,12 +116,12 @@ class PointConstraint:
     without slip.
 
     ``body``: link/frame name or body index; ``point`` (3,): the point in the coordinates of
-    that link/frame (m); ``target`` (3,): its world position (m), used by the Baumgarte
-    position term. Force: ``[fx, fy, fz]`` (N) applied to the body at the point, world axes.
+    that link/frame (m); ``target`` (3,): the world position where it is held (m), used by
+    the Baumgarte position term. Force: ``[fx, fy, fz]`` (N) applied to the body at the point, world axes.
     """
     body: str | int
-    point: np.ndarray = (0.0, 0.0, 0.0)
-    target: np.ndarray = (0.0, 0.0, 0.0)
+    point: np.ndarray
+    target: np.ndarray
 
     dim = 3
 
@@ -340,7 +340,7 @@ def _check_baumgarte(baumgarte) -> tuple[float, float]:
     return alpha, beta
 
 
-def cholesky(model, M: np.ndarray, what: str) -> np.ndarray:
+def cholesky(M: np.ndarray, what: str) -> np.ndarray:
     """Lower Cholesky factors of the mass matrices (B, nv, nv); ValueError if one is not
     positive definite."""
     try:
@@ -405,7 +405,7 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
              check_finite=False).reshape(-1, nv)
     Jc, Jdv, phi = constraint_jacobian(model, x["q"], x["v"], constraints)
     V, TAU = _inputs.as_batch(x["v"]), _inputs.as_batch(x["tau"])
-    L = cholesky(model, M, "constrained_dynamics")
+    L = cholesky(M, "constrained_dynamics")
     LT = np.swapaxes(L, 1, 2)
     a0 = np.linalg.solve(LT, np.linalg.solve(L, (TAU - h)[..., None]))[..., 0]
     Y = np.linalg.solve(L, np.swapaxes(Jc, 1, 2))                    # L^-1 J_c^T (B, nv, m)
