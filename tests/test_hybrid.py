@@ -95,7 +95,8 @@ def test_two_link_arm_closed_form():
 
 @pytest.mark.parametrize("path, floating_base", pairs())
 def test_urdf_against_pinocchio_terms(path, floating_base):
-    """On real robots: the partitioned solve with Pinocchio's crba and nonLinearEffects."""
+    """On real robots: the partitioned solve with Pinocchio's crba and nonLinearEffects, and
+    Pinocchio's rnea and aba at the two extremes."""
     pair = load_pair(path, floating_base)
     model, pm, data = pair.model, pair.pm, pair.data
     for trial in range(2):
@@ -109,6 +110,11 @@ def test_urdf_against_pinocchio_terms(path, floating_base):
         a_out, tau_out = rd.hybrid_dynamics(model, q, v, a, tau_known, mask, friction=False)
         assert_rel(a_out, a_ref, 1e-8, "a")
         assert_rel(tau_out, tau_ref, 1e-8, "tau")
+    # the extremes: Pinocchio's rnea and aba
+    _, tau_out = rd.hybrid_dynamics(model, q, v, a, tau_known, np.ones(model.nv, bool), friction=False)
+    assert_rel(tau_out, pin.rnea(pm, data, qp, v, a), 1e-9, "all known")
+    a_out, _ = rd.hybrid_dynamics(model, q, v, a, tau_known, np.zeros(model.nv, bool), friction=False)
+    assert_rel(a_out, pin.aba(pm, data, qp, v, tau_known), 1e-9, "none known")
 
 
 def test_batch_matches_single_states():
