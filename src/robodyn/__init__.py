@@ -20,6 +20,11 @@ _LAZY = {
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
     "nonlinear_effects": "terms",
+    "hybrid_dynamics": "hybrid", "inverse_mass_matrix": "minv", "constrained_dynamics": "constrained",
+    "ConstrainedDynamics": "constrained", "PointConstraint": "constrained", "WeldConstraint": "constrained",
+    "LoopConstraint": "constrained", "DistanceConstraint": "constrained", "CouplingConstraint": "constrained",
+    "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
+    "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
 }
 
 
@@ -48,4 +53,7 @@ __all__ = [
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
+    "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",
+    "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
+    "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
 ]

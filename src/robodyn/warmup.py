@@ -32,3 +32,5 @@ def warmup() -> None:
             rd.jacobian(model, q, model.nbodies - 1)
             rd.jacobian_dot_times_v(model, q, v, model.nbodies - 1)
             rd.forward_kinematics(model, q)
+            rd.hybrid_dynamics(model, q, v, a, a, np.arange(model.nv) == model.nv - 1)
+            rd.inverse_mass_matrix(model, q)

@@ -65,6 +65,12 @@ def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, stat
                                      OP[s], ACC[s], VEL[s], ws)
 
 
+@kernel
+def _jacobian_single(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b):
+    ws = motion_workspace(ints.shape[0], dofs.shape[0])
+    return jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws)
+
+
 def _run(model, x, b, check, what):
     """Flat-batch results ``(J, oR_b, op_b, acc_b, vel_b)`` for the states ``x``."""
     k = model._kernel
@@ -73,8 +79,12 @@ def _run(model, x, b, check, what):
     B = q.shape[0]
     JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
     ACC, VEL, status = np.empty((B, 6)), np.empty((B, 6)), np.empty(B, dtype=np.int64)
-    _jacobian_batch(k["ints"], k["body"], k["dofs"][(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL, status,
-                    _inputs.chunks(B))
+    if x["q"].ndim == 1:  # one state: no parallel launch
+        status[0] = _jacobian_single(k["ints"], k["body"], k["dofs"][(False, False)], q[0], v[0], b, check, JJ[0],
+                                     OR[0], OP[0], ACC[0], VEL[0])
+    else:
+        _jacobian_batch(k["ints"], k["body"], k["dofs"][(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL,
+                        status, _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return JJ, OR, OP, ACC, VEL
 

@@ -1,0 +1,284 @@
+"""Hybrid dynamics by the articulated-body method (RBDA section 9.2), O(n).
+
+Some joints have a known (prescribed) acceleration and an unknown force, the others a known
+force and an unknown acceleration. A joint with a known acceleration moves as if rigid for
+the articulated-body recursion: its body passes its full inertia ``IA_i`` to the parent,
+and its known motion enters the velocity-product term ``c_i``.
+
+Pass 1 (root to leaves): ``v_i = iX_p v_p + S_i qd_i``, ``c_i = v_i x S_i qd_i``
+(``+ S_i qdd_i`` when the joint's acceleration is known), ``IA_i = I_i``,
+``pA_i = v_i x* I_i v_i - f_ext_i``.
+
+Pass 2 (leaves to root), a joint with unknown acceleration as in the ABA
+(``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``, ``u_i = tau_i - S_i^T pA_i (- friction)``,
+``Ia = IA_i - U_i D_i^-1 U_i^T``, ``pa = pA_i + Ia c_i + U_i D_i^-1 u_i``); a joint with
+known acceleration passes ``Ia = IA_i`` and ``pa = pA_i + IA_i c_i``. Then
+``IA_p += iX_p^T Ia iX_p``, ``pA_p += iX_p^T pa``.
+
+Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i = iX_p a_p + c_i``; unknown acceleration:
+``qdd_i = D_i^-1 (u_i - U_i^T a_i)``, ``a_i += S_i qdd_i``; known acceleration:
+``tau_i = S_i^T (IA_i a_i + pA_i) (+ armature qdd_i + friction)``, the force transmitted by
+the joint to the articulated subtree beyond it.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from .._jit import core, inline, kernel, parallel
+from .. import joints as J
+from ..joints import friction_torque
+from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul, matvec6,
+                       motion_act_inv, motion_cross, wrench_to_local)
+from . import _inputs
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from .aba import SINGULAR_RTOL, invert_block, workspace
+from .kinematics import placements, world_placements
+
+
+@inline
+def finite_where(x, mask, value):
+    """True when ``x[k]`` is finite for every ``k`` with ``mask[k] == value``."""
+    for k in range(x.shape[0]):
+        if mask[k] == value and not np.isfinite(x[k]):
+            return False
+    return True
+
+
+@core
+def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
+    """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,). ``known[k]``: the
+    acceleration of dof ``k`` is given (all dofs of a joint alike). Returns a status (see
+    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular."""
+    (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
+     B3, PB, UD, G, t1, t2, Ia) = ws
+    nb, nv = ints.shape[0], dofs.shape[0]
+    if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
+            and tau_known.shape[0] == nv and known.shape[0] == nv):
+        return WRONG_SIZE
+    if check and not (finite(q) and finite(v) and finite_where(qdd_known, known, True)
+                      and finite_where(tau_known, known, False)):
+        return NONFINITE
+    if not placements(ints, body, q, liR, lip, Rj, pj):
+        return BAD_QUATERNION
+    eps = params[3]
+    if fcode > 0:
+        world_placements(ints, liR, lip, oR, op)
+    # Pass 1: velocities, velocity-product accelerations (with the known joint accelerations)
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+        else:
+            vel[i, :] = 0.0
+        t1[:] = 0.0
+        for k in range(iv, iv + n):
+            for r in range(6):
+                t1[r] += dofs[k, r] * v[k]
+        for r in range(6):
+            vel[i, r] += t1[r]
+        motion_cross(vel[i], t1, c[i])
+        if known[iv]:
+            for k in range(iv, iv + n):
+                for r in range(6):
+                    c[i, r] += dofs[k, r] * qdd_known[k]
+        theta = body[i, 15:25]
+        inertia_matrix(theta, IA[i])
+        inertia_mul(theta, vel[i], t1)
+        force_cross(vel[i], t1, pA[i])
+        if fcode >= 0:
+            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
+            for r in range(6):
+                pA[i, r] -= t1[r]
+    # Pass 2: articulated inertias, the joints of known acceleration held rigid
+    for i in range(nb - 1, -1, -1):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if known[iv]:
+            if par >= 0:
+                matvec6(IA[i], c[i], t1)
+                for r in range(6):
+                    t2[r] = pA[i, r] + t1[r]
+                congruence_to_parent(liR[i], lip[i], IA[i], B3, PB, IA[par])
+                force_act(liR[i], lip[i], t2, t1)
+                for r in range(6):
+                    pA[par, r] += t1[r]
+            continue
+        scale = 0.0
+        for r in range(6):
+            scale += abs(IA[i, r, r])
+        for k in range(iv, iv + n):
+            matvec6(IA[i], dofs[k, :6], U[k])
+            s = 0.0
+            for r in range(6):
+                s += dofs[k, r] * pA[i, r]
+            u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
+            for j in range(iv, iv + n):
+                d = 0.0
+                for r in range(6):
+                    d += dofs[j, r] * U[k, r]
+                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
+        if n == 1:
+            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
+                return i + 1
+            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
+        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+            return i + 1
+        if par >= 0:
+            for r in range(6):
+                for j in range(n):
+                    s = 0.0
+                    for k in range(n):
+                        s += U[iv + k, r] * Dinv[iv + k, j]
+                    UD[r, j] = s
+            for r in range(6):
+                for cc in range(6):
+                    s = IA[i, r, cc]
+                    for j in range(n):
+                        s -= UD[r, j] * U[iv + j, cc]
+                    Ia[r, cc] = s
+            matvec6(Ia, c[i], t1)
+            for r in range(6):
+                s = pA[i, r] + t1[r]
+                for j in range(n):
+                    s += UD[r, j] * u[iv + j]
+                t2[r] = s
+            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
+            force_act(liR[i], lip[i], t2, t1)
+            for r in range(6):
+                pA[par, r] += t1[r]
+    # Pass 3: accelerations of the free joints, forces of the prescribed ones
+    for k in range(6):
+        t2[k] = 0.0
+    t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], acc[par], acc[i])
+        else:
+            motion_act_inv(liR[i], lip[i], t2, acc[i])
+        for r in range(6):
+            acc[i, r] += c[i, r]
+        if known[iv]:
+            matvec6(IA[i], acc[i], t1)
+            for r in range(6):
+                t1[r] += pA[i, r]
+            for k in range(iv, iv + n):
+                qdd[k] = qdd_known[k]
+                s = 0.0
+                for r in range(6):
+                    s += dofs[k, r] * t1[r]
+                tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
+            continue
+        for k in range(iv, iv + n):
+            s = 0.0
+            for r in range(6):
+                s += U[k, r] * acc[i, r]
+            t1[k - iv] = u[k] - s
+        for j in range(iv, iv + n):
+            s = 0.0
+            for k in range(n):
+                s += Dinv[j, k] * t1[k]
+            qdd[j] = s
+            tau[j] = tau_known[j]
+        for k in range(iv, iv + n):
+            for r in range(6):
+                acc[i, r] += dofs[k, r] * qdd[k]
+    return OK
+
+
+@parallel
+def _hybrid_batch(ints, body, dofs, params, Q, V, A, T, known, F, fcode, check, QDD, TAU, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = hybrid_one(ints, body, dofs, params, Q[s], V[s], A[s], T[s], known,
+                                   F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], TAU[s], ws)
+
+
+@kernel
+def _hybrid_single(ints, body, dofs, params, q, v, a, tau_in, known, fext, fcode, check, qdd, tau):
+    return hybrid_one(ints, body, dofs, params, q, v, a, tau_in, known, fext, fcode, check, qdd, tau,
+                      workspace(ints.shape[0], dofs.shape[0]))
+
+
+def known_dofs(model, known_mask) -> np.ndarray:
+    """``known_mask`` checked: a boolean (nv,) array in which the six entries of a free joint
+    are all True or all False."""
+    mask = np.asarray(known_mask)
+    if mask.shape != (model.nv,):
+        raise ValueError(f"known_mask: expected shape ({model.nv},), got {mask.shape}")
+    if mask.dtype != bool:
+        if not (np.issubdtype(mask.dtype, np.integer) and np.all((mask == 0) | (mask == 1))):
+            raise ValueError(f"known_mask: expected booleans (or 0/1), got {mask.dtype} values {mask.tolist()}")
+        mask = mask.astype(bool)
+    for i in np.flatnonzero(model.joint_type == J.FREE):
+        k = model.idx_v[i]
+        block = mask[k:k + 6]
+        if block.any() != block.all():
+            raise ValueError(
+                f"known_mask: the six entries {k}..{k + 5} of free joint {model.body_joint_names[i]!r} must be "
+                f"all True (base acceleration given) or all False (base wrench given), got {block.tolist()}")
+    return np.ascontiguousarray(mask)
+
+
+def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_ext_frame: str = "local", *,
+                    friction: bool = True, armature: bool = True,
+                    check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Hybrid dynamics: given the accelerations of some joints and the forces of the others,
+    the missing forces and accelerations.
+
+    Solves ``M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i (+ armature a + friction) = tau``
+    for ``tau[known]`` and ``a[~known]`` given ``a[known]`` and ``tau[~known]``, in O(n).
+
+    Args:
+        q: (..., nq). v: (..., nv).
+        a_known: (..., nv) accelerations; only the entries where ``known_mask`` is True are read.
+        tau_known: (..., nv) joint forces; only the entries where ``known_mask`` is False are read.
+        known_mask: (nv,) booleans, one per entry of ``v``, the same for every state of a batch:
+            True where the acceleration is given. A free joint (floating base) has either all
+            six entries True (its acceleration ``[a_lin; alpha]`` in the base frame is given,
+            its wrench computed) or all six False (its wrench ``[force; torque]`` in the base
+            frame is given, usually zero, and its acceleration computed).
+        f_ext, f_ext_frame, friction, armature, check_finite: as in :func:`robodyn.rnea`.
+            Entries that are not read may be NaN.
+
+    Returns:
+        ``(a, tau)``, both (..., nv) and complete: ``a[known] == a_known[known]`` and
+        ``tau[~known] == tau_known[~known]``, so that ``rnea(q, v, a) == tau``.
+
+    Equivalences: with every entry known, ``tau == rnea(q, v, a_known)``; with none known,
+    ``a == aba(q, v, tau_known)``. Raises ValueError when the articulated inertia of a body
+    whose acceleration is unknown is singular. Reference: Featherstone, RBDA (2008),
+    section 9.2.
+    """
+    known = known_dofs(model, known_mask)
+    k = model._kernel
+    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
+        a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
+        if _hybrid_single(k["ints"], k["body"], dofs, params, q, v, a_known, tau_known, known, k["zero_wrench"],
+                          -1, check_finite, a, tau) == OK:
+            return a, tau
+    batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    args = (k["ints"], k["body"], dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
+            check_finite)
+    if batch == ():
+        a, tau = np.empty(model.nv), np.empty(model.nv)
+        status = _hybrid_single(*args, a, tau)
+    else:
+        B = x["q"].shape[0]
+        a, tau, status = np.empty((B, model.nv)), np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
+        _hybrid_batch(*args, a, tau, status, _inputs.chunks(B))
+    if np.any(status):
+        report = {"q": x["q"], "v": x["v"], "a_known": np.where(known, x["a_known"], 0.0),
+                  "tau_known": np.where(known, 0.0, x["tau_known"])}
+        bad = _inputs.raise_for_status(model, status, report, "hybrid_dynamics")
+        i = bad - 1
+        raise ValueError(
+            f"hybrid_dynamics: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
+            f"{model.body_joint_names[i]!r}) is singular, so its acceleration is undefined; prescribe the "
+            "acceleration of that joint, or give the bodies beyond it mass and inertia (or armature)")
+    return _inputs.unflatten(a, batch), _inputs.unflatten(tau, batch)

@@ -1,0 +1,185 @@
+"""Inverse of the joint-space inertia matrix by the articulated-body algorithm, O(n^2).
+
+``M(q)^-1`` is the forward dynamics of unit joint forces without velocity and gravity: its
+column ``k`` is ``aba(q, 0, e_k)`` with ``g = 0``. The ABA runs once on all ``nv`` columns at
+once (Carpentier and Mansard 2018; RBDA section 7.3), the bias forces and
+accelerations becoming 6 x nv matrices:
+
+Pass 2 (leaves to root), with ``F_i = 0`` (6, nv) at the start:
+``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``, ``u_i = E_i - S_i^T F_i`` (``E_i`` the rows
+of the identity of the joint's dofs), ``IA_p += iX_p^T (IA_i - U_i D_i^-1 U_i^T) iX_p``,
+``F_p += iX_p^T (F_i + U_i D_i^-1 u_i)``.
+
+Pass 3 (root to leaves), with ``A_0 = 0``: ``A_i' = iX_p A_p``,
+``Minv[dofs of i, :] = D_i^-1 (u_i - U_i^T A_i')``, ``A_i = A_i' + S_i Minv[dofs of i, :]``.
+
+Bodies are numbered after their ancestors, so the dofs of a body's subtree all come at or
+after its own first dof ``k_i``: the columns ``< k_i`` of ``F_i`` and ``u_i`` are zero, and
+only the upper triangle (columns ``>= k_i`` of the rows of body ``i``) is computed, then
+mirrored.
+
+Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
+algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Table 7.1.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from .._jit import core, kernel, parallel
+from ..spatial import congruence_to_parent, force_act, inertia_matrix, matvec6, motion_act_inv
+from . import _inputs
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from .aba import SINGULAR_RTOL, invert_block
+from .kinematics import placements
+
+
+@kernel
+def workspace(nb, nv):
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3), np.empty((nb, 6, 6)),
+            np.empty((nv, 6)), np.empty((nv, 6)), np.empty((nb, 6, nv)), np.empty((3, 3, 3)), np.empty((3, 3)),
+            np.empty((6, 6)), np.empty((6, 12)), np.empty((6, 6)), np.empty(6), np.empty(6))
+
+
+@core
+def minv_one(ints, body, dofs, q, check, Minv, ws):
+    """``Minv`` (nv, nv) at ``q``; returns a status (see ``_inputs``), ``i + 1`` when the
+    articulated inertia of body ``i`` is singular."""
+    liR, lip, Rj, pj, IA, U, Dinv, F, B3, PB, UD, G, Ia, t1, t2 = ws
+    nb, nv = ints.shape[0], dofs.shape[0]
+    if q.shape[0] != nq_of(ints):
+        return WRONG_SIZE
+    if check and not finite(q):
+        return NONFINITE
+    if not placements(ints, body, q, liR, lip, Rj, pj):
+        return BAD_QUATERNION
+    for i in range(nb):
+        inertia_matrix(body[i, 15:25], IA[i])
+        F[i, :, :] = 0.0
+    # Pass 2: articulated inertias and the bias forces of the unit joint forces;
+    # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it
+    for i in range(nb - 1, -1, -1):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        scale = 0.0
+        for r in range(6):
+            scale += abs(IA[i, r, r])
+        for k in range(iv, iv + n):
+            matvec6(IA[i], dofs[k, :6], U[k])
+            for j in range(iv, iv + n):
+                d = 0.0
+                for r in range(6):
+                    d += dofs[j, r] * U[k, r]
+                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
+            for col in range(iv, nv):
+                s = 0.0
+                for r in range(6):
+                    s += dofs[k, r] * F[i, r, col]
+                Minv[k, col] = (1.0 if col == k else 0.0) - s
+        if n == 1:
+            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
+                return i + 1
+            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
+        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+            return i + 1
+        if par >= 0:
+            for r in range(6):
+                for j in range(n):
+                    s = 0.0
+                    for k in range(n):
+                        s += U[iv + k, r] * Dinv[iv + k, j]
+                    UD[r, j] = s
+            for r in range(6):
+                for cc in range(6):
+                    s = IA[i, r, cc]
+                    for j in range(n):
+                        s -= UD[r, j] * U[iv + j, cc]
+                    Ia[r, cc] = s
+            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
+            for col in range(iv, nv):
+                for r in range(6):
+                    s = F[i, r, col]
+                    for j in range(n):
+                        s += UD[r, j] * Minv[iv + j, col]
+                    t2[r] = s
+                force_act(liR[i], lip[i], t2, t1)
+                for r in range(6):
+                    F[par, r, col] += t1[r]
+    # Pass 3: accelerations of the unit joint forces (F now holds the body accelerations)
+    for i in range(nb):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        for col in range(iv, nv):
+            if par >= 0:
+                for r in range(6):
+                    t1[r] = F[par, r, col]
+                motion_act_inv(liR[i], lip[i], t1, t2)
+            else:
+                t2[:] = 0.0
+            for k in range(iv, iv + n):
+                s = 0.0
+                for r in range(6):
+                    s += U[k, r] * t2[r]
+                t1[k - iv] = Minv[k, col] - s
+            for j in range(iv, iv + n):
+                s = 0.0
+                for k in range(n):
+                    s += Dinv[j, k] * t1[k]
+                Minv[j, col] = s
+                for r in range(6):
+                    t2[r] += dofs[j, r] * s
+            for r in range(6):
+                F[i, r, col] = t2[r]
+    for k in range(nv):
+        for col in range(k + 1, nv):
+            Minv[col, k] = Minv[k, col]
+    return OK
+
+
+@parallel
+def _minv_batch(ints, body, dofs, Q, check, MM, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
+
+
+@kernel
+def _minv_single(ints, body, dofs, q, check, Minv):
+    return minv_one(ints, body, dofs, q, check, Minv, workspace(ints.shape[0], dofs.shape[0]))
+
+
+def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
+    """Inverse of the joint-space inertia matrix, ``M(q)^-1``, full and symmetric, in O(n^2).
+
+    q: (..., nq). Returns (..., nv, nv). ``armature`` as in :func:`robodyn.crba`: the inverse
+    of ``crba(q, armature=armature)``.
+
+    Equivalences: ``inverse_mass_matrix(q) @ crba(q) == I``; column ``k`` is the acceleration
+    of a unit force at dof ``k`` without velocity and gravity. Raises ValueError when a body's
+    articulated inertia is singular (``M`` is then singular too). Reference: Carpentier and
+    Mansard, RSS 2018 (Pinocchio's ``computeMinverse``); RBDA Table 7.1.
+    """
+    k = model._kernel
+    dofs = k["dofs"][(False, bool(armature))]
+    if _inputs.vectors(q):
+        Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
+        if _minv_single(k["ints"], k["body"], dofs, q, check_finite, Minv) == OK:
+            return Minv
+    batch, x = _inputs.states(model, q=q)
+    q = x["q"]
+    if batch == ():
+        Minv = np.empty((model.nv, model.nv))
+        status = _minv_single(k["ints"], k["body"], dofs, q, check_finite, Minv)
+    else:
+        B = q.shape[0]
+        Minv, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
+        _minv_batch(k["ints"], k["body"], dofs, q, check_finite, Minv, status, _inputs.chunks(B))
+    bad = _inputs.raise_for_status(model, status, x, "inverse_mass_matrix")
+    if bad:
+        i = bad - 1
+        raise ValueError(
+            f"inverse_mass_matrix: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
+            f"{model.body_joint_names[i]!r}) is singular, so M(q) is singular; give the bodies beyond it mass "
+            "and inertia about the joint axis (or armature)")
+    return _inputs.unflatten(Minv, batch)
