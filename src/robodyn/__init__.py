@@ -19,8 +19,11 @@ _LAZY = {
     "coriolis_matrix": "coriolis", "crba": "crba", "kinetic_energy": "energy", "potential_energy": "energy",
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
-    "nonlinear_effects": "terms",
+    "nonlinear_effects": "terms", "integrate": "integrate", "difference": "integrate",
 }
+# Applications, also imported on first use: name -> module.
+_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
+              "plots": None}
 
 
 def __getattr__(name):
@@ -28,6 +31,13 @@ def __getattr__(name):
         import importlib
 
         value = getattr(importlib.import_module(f".algorithms.{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in _LAZY_APPS:
+        import importlib
+
+        module = importlib.import_module(f".{_LAZY_APPS[name] or name}", __name__)
+        value = module if _LAZY_APPS[name] is None else getattr(module, name)
         globals()[name] = value
         return value
     if name == "warmup":
@@ -38,7 +48,7 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY) | {"warmup"})
+    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_APPS) | {"warmup"})
 
 
 __version__ = "0.1.0"
@@ -48,4 +58,5 @@ __all__ = [
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
+    "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
 ]
