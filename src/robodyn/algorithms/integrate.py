@@ -106,7 +106,7 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
         q: (..., nq) configuration (unit quaternions for free joints). v: (..., nv).
 
     Returns:
-        (..., nq), unit quaternions. Equals Pinocchio's ``integrate(model, q, v)``;
+        (..., nq), unit quaternions of the sign nearer ``q``'s (``q_quat . out_quat >= 0``). Equals Pinocchio's ``integrate(model, q, v)``;
         ``difference(model, q, integrate(model, q, v)) == v`` for rotations below pi.
     Reference: Lynch and Park, *Modern Robotics*, eq. (3.88).
     """
@@ -121,6 +121,7 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
         dquat, dp = exp_se3(v[..., kv:kv + 6])
         out[..., kq:kq + 3] = q[..., kq:kq + 3] + np.einsum("...ij,...j->...i", _quat_matrix(quat0), dp)
         quat = _quat_mul(quat0, dquat)
+        quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
         out[..., kq + 3:kq + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
     return _inputs.unflatten(out, batch)
 
