@@ -7,7 +7,10 @@
 * :class:`Sampled`: samples ``(t_k, q_k)`` (e.g. a CSV file) interpolated by a cubic spline
   (not-a-knot end conditions; scipy's ``CubicSpline``).
 
-Before the start and after the end a reference holds its first / last position at rest.
+Before the start and after the end a reference holds its first / last position at rest
+(a point-to-point reference gives its polynomial's values on the closed interval, so the
+cubic's acceleration jumps at both ends: fixed-step integrators are most accurate with the
+quintic).
 """
 
 from __future__ import annotations
@@ -53,11 +56,11 @@ class PointToPoint:
         self.duration, self.t0, self.profile = float(duration), float(t0), profile
 
     def __call__(self, t: float):
-        x = min(max((t - self.t0) / self.duration, 0.0), 1.0)
+        x = (t - self.t0) / self.duration
         s, ds, dds = _SCALINGS[self.profile]
         d = self.q1 - self.q0
-        if x <= 0.0 or x >= 1.0:  # at rest outside the motion
-            return self.q0 + s(x) * d, np.zeros_like(d), np.zeros_like(d)
+        if x < 0.0 or x > 1.0:  # at rest outside the motion
+            return (self.q0 if x < 0.0 else self.q1).copy(), np.zeros_like(d), np.zeros_like(d)
         return self.q0 + s(x) * d, ds(x) / self.duration * d, dds(x) / self.duration ** 2 * d
 
 
