@@ -179,3 +179,12 @@ def test_bad_input():
         control.cubic([0], [1, 2], 1.0)
     with pytest.raises(ValueError, match=r"strictly increasing"):
         control.Sampled([0.0, 0.0], [[0.0], [1.0]])
+
+
+def test_task_space_jacobian_is_the_library_one():
+    panda = rd.models.load("panda")
+    ts = control.TaskSpacePD(panda, "flange", [0.3, 0.0, 0.5], 1.0, 1.0)
+    q = rng_for("ts-jacobian").uniform(-1, 1, 7)
+    x, Jl = ts.position_and_jacobian(q)
+    np.testing.assert_allclose(x, rd.frame_pose(panda, q, "flange")[:3, 3], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(Jl, rd.jacobian(panda, q, "flange", "local_world_aligned")[:3], rtol=0, atol=1e-13)

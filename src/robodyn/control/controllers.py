@@ -27,8 +27,8 @@ import numpy as np
 
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
-from ..algorithms.jacobian import jacobian
-from ..algorithms.kinematics import frame_pose
+from ..algorithms._inputs import raise_for_status
+from . import _kernels
 from ..algorithms.rnea import rnea
 from ..algorithms.terms import gravity
 
@@ -131,21 +131,35 @@ class TaskSpacePD(Controller):
 
     def __init__(self, model, frame: str, x_desired, kp, kd, joint_damping=1.0):
         super().__init__(model)
-        frame_pose(model, np.zeros(model.nq), frame)  # raises for an unknown frame
-        self.frame = frame
+        b, self._R, self._p = model.frame_index(frame)
+        if b < 0:
+            raise ValueError(f"frame {frame!r} is fixed to the world; it cannot be moved")
+        self.frame, self._body = frame, b
         self.x_d = np.array(x_desired, dtype=float)
         if self.x_d.shape != (3,) or not np.all(np.isfinite(self.x_d)):
             raise ValueError(f"x_desired: expected 3 finite numbers, got shape {self.x_d.shape}")
         self.kp, self.kd = gain("kp", kp, 3), gain("kd", kd, 3)
         self.damping = gain("joint_damping", joint_damping, model.nv)
 
+    def position_and_jacobian(self, q):
+        """World position (3,) of the frame origin and its linear Jacobian (3, nv) in world
+        axes (the rows ``[:3]`` of ``jacobian(model, q, frame, "local_world_aligned")``)."""
+        k = self.model._kernel
+        q = np.ascontiguousarray(q, dtype=float)
+        J, R, p = np.empty((6, self.model.nv)), np.empty((3, 3)), np.empty(3)
+        status = _kernels.body_jacobian(k["ints"], k["body"], k["dofs"][False, False], q, self._body, J, R, p)
+        raise_for_status(self.model, status, {"q": q}, "TaskSpacePD")
+        x = p + R @ self._p
+        x_cross = np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+        return x, J[:3] - x_cross @ J[3:]  # velocity of the point x: v_O + omega x x
+
     def position(self, q):
         """World position (3,) of the controlled frame."""
-        return frame_pose(self.model, q, self.frame)[:3, 3]
+        return self.position_and_jacobian(q)[0]
 
     def __call__(self, t, q, v):
-        Jl = jacobian(self.model, q, self.frame, "local_world_aligned")[:3]
-        f = self.kp * (self.x_d - self.position(q)) - self.kd * (Jl @ v)
+        x, Jl = self.position_and_jacobian(q)
+        f = self.kp * (self.x_d - x) - self.kd * (Jl @ v)
         return Jl.T @ f - self.damping * v + gravity(self.model, q)
 
     def lyapunov(self, t, q, v):
