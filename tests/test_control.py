@@ -188,3 +188,38 @@ def test_task_space_jacobian_is_the_library_one():
     x, Jl = ts.position_and_jacobian(q)
     np.testing.assert_allclose(x, rd.frame_pose(panda, q, "flange")[:3, 3], rtol=0, atol=1e-14)
     np.testing.assert_allclose(Jl, rd.jacobian(panda, q, "flange", "local_world_aligned")[:3], rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi_implicit_euler", "DOP853"])
+def test_pid_integral_state_removes_the_offset_of_a_wrong_gravity_model(integrator):
+    """The controller's internal state is integrated with the robot: z(t) is the integral of
+    the error, and the integral action cancels the gravity error PD alone leaves."""
+    plant = planar_2r()
+    wrong = plant.with_inertial_parameters(0.8 * plant.inertial_parameters())
+    pid = control.PIDGravity(wrong, [0.5, 0.5], kp=[800.0, 400.0], ki=[1500.0, 600.0], kd=[200.0, 80.0])
+    if integrator == "DOP853":  # adaptive: agrees with RK4 on a short run
+        traj = rd.simulate(plant, [0.5, 0.5], [0.0, 0.0], 0.05, 1e-3, controller=pid, integrator=integrator)
+        rk4 = rd.simulate(plant, [0.5, 0.5], [0.0, 0.0], 0.05, 1e-3, controller=pid)
+        np.testing.assert_allclose(traj.controller_state, rk4.controller_state, rtol=0,
+                                   atol=1e-7 * np.abs(rk4.controller_state).max())
+    else:
+        traj = rd.simulate(plant, [0.5, 0.5], [0.0, 0.0], 4.0, 1e-3, controller=pid, integrator=integrator)
+        e = 0.5 - traj.q
+        integral = np.concatenate([[np.zeros(2)], np.cumsum(0.5 * (e[1:] + e[:-1]) * 1e-3, axis=0)])
+        tol = 1e-3 if integrator == "semi_implicit_euler" else 1e-6
+        np.testing.assert_allclose(traj.controller_state, integral, rtol=0, atol=tol * np.abs(integral).max())
+        assert np.abs(e[-1]).max() < 1e-3
+        np.testing.assert_allclose(pid.ki * traj.controller_state[-1], rd.gravity(plant, traj.q[-1])
+                                   - rd.gravity(wrong, traj.q[-1]), rtol=2e-2)
+    np.testing.assert_allclose(traj.tau[5], pid.torque(traj.t[5], traj.q[5], traj.v[5], traj.controller_state[5]),
+                               rtol=1e-12)
+
+
+def test_bad_controller_state():
+    class Broken(control.PIDGravity):
+        def state_rate(self, t, q, v, z):
+            return np.zeros(3)
+
+    model = planar_2r()
+    with pytest.raises(ValueError, match=r"controller: state_rate returned shape \(3,\) at t = 0"):
+        rd.simulate(model, [0, 0], [0, 0], 0.01, 1e-3, controller=Broken(model, [0, 0], 1.0, 1.0, 1.0))

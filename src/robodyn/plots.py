@@ -108,12 +108,16 @@ def _draw_energy(ax, traj) -> dict:
     ax.plot(traj.t, traj.kinetic, label="kinetic")
     ax.plot(traj.t, traj.potential, label="potential")
     ax.plot(traj.t, traj.energy, "k", label="total")
-    if traj.lyapunov is not None:
-        ax.plot(traj.t, traj.lyapunov, "r--", label="Lyapunov V")
-    ax.set_ylabel("J")
+    ax.set_ylabel("energy [J]")
     ax.set_xlabel("t [s]")
-    ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
+    handles, labels = ax.get_legend_handles_labels()
+    if traj.lyapunov is not None:  # on its own scale (right axis)
+        right = ax.twinx()
+        handles += right.plot(traj.t, traj.lyapunov, "r--", label="Lyapunov V (right axis)")
+        labels.append("Lyapunov V (right axis)")
+        right.set_ylabel("V", color="r")
+    ax.legend(handles, labels, fontsize=8)
     return data
 
 

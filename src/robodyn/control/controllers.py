@@ -10,6 +10,7 @@ with ``q~ = q - q_d``). Gains are scalars or (nv,) vectors (diagonal gain matric
 controller          law                                                      Lyapunov function
 =================== ======================================================== ===================================
 PDGravity           ``Kp e - Kd qd + g(q)``                                  ``qd^T M qd / 2 + e^T Kp e / 2``
+PIDGravity          ``Kp e + Ki int(e) - Kd qd + g(q)``                      (none reported)
 ComputedTorque      ``M (qdd_d + Kd ed + Kp e) + C qd + g (+ friction)``     ``ed^T ed / 2 + e^T Kp e / 2``
 TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``           ``qd^T M qd / 2 + ex^T Kp ex / 2``
 SlotineLi           ``M qdd_r + C qd_r + g (+ friction) - Kd s``             ``s^T M s / 2 + q~^T Lambda Kd q~``
@@ -45,12 +46,20 @@ def gain(name: str, value, n: int) -> np.ndarray:
 
 
 class Controller:
-    """A control law ``tau = controller(t, q, v)`` computed with ``model`` (fixed base)."""
+    """A control law ``tau = controller(t, q, v)`` computed with ``model`` (fixed base).
+
+    A controller with an internal state ``z`` (integral action, parameter estimates of an
+    adaptive law) sets ``state0`` (nz,) and defines ``torque(t, q, v, z)`` and
+    ``state_rate(t, q, v, z) -> z'``; :func:`robodyn.simulate` integrates ``z`` with the
+    robot (and passes it to ``lyapunov(t, q, v, z)``). See :class:`PIDGravity`.
+    """
 
     #: ``lyapunov(t, q, v) -> float`` where theory gives one, else None.
     lyapunov = None
     #: ``desired(t) -> (q_d, qd_d, qdd_d)`` (each (nv,)) for a joint-space reference, else None.
     desired = None
+    #: Initial internal state (nz,) of a controller that has one, else None.
+    state0 = None
 
     def __init__(self, model):
         if model.nq != model.nv:
@@ -95,6 +104,36 @@ class PDGravity(Controller):
     def lyapunov(self, t, q, v):
         e = self.q_d - q
         return 0.5 * v @ crba(self.model, q) @ v + 0.5 * e @ (self.kp * e)
+
+
+class PIDGravity(PDGravity):
+    """PID control with gravity compensation to a set point, with the integral of the error
+    as internal state ``z`` (``z' = q_d - q``, ``z(0) = 0``)::
+
+        tau = Kp e + Ki z - Kd qd + g(q)
+
+    The integral action removes the steady-state error left by a wrong gravity model or a
+    constant disturbance. Its stability needs conditions on the gains (Kelly, "Global
+    positioning of robot manipulators via PD control plus a class of nonlinear integral
+    actions", IEEE TAC 43(7), 1998); no Lyapunov function is reported. Called as
+    ``controller(t, q, v)`` outside a simulation it uses ``z = 0``.
+    """
+
+    lyapunov = None
+
+    def __init__(self, model, q_desired, kp, ki, kd):
+        super().__init__(model, q_desired, kp, kd)
+        self.ki = gain("ki", ki, model.nv)
+        self.state0 = np.zeros(model.nv)
+
+    def torque(self, t, q, v, z):
+        return PDGravity.__call__(self, t, q, v) + self.ki * z
+
+    def state_rate(self, t, q, v, z):
+        return self.q_d - q
+
+    def __call__(self, t, q, v):
+        return self.torque(t, q, v, self.state0)
 
 
 class ComputedTorque(Controller):

@@ -79,6 +79,31 @@ def _positive(name: str, x) -> float:
     return x
 
 
+class _Law:
+    """The controller as the integrators see it: ``torque(t, q, v, z)`` and the rate of its
+    internal state ``z`` (empty for a stateless callable ``(t, q, v) -> tau``)."""
+
+    def __init__(self, controller, model):
+        self.controller = controller
+        if controller is None:
+            zero = np.zeros(model.nv)
+            self.controller = lambda t, q, v: zero
+        z0 = getattr(controller, "state0", None)
+        self.stateful = z0 is not None
+        self.z0 = np.zeros(0) if z0 is None else _vector("controller.state0", z0, np.size(z0))
+        self.nz = self.z0.shape[0]
+
+    def torque(self, t, q, v, z):
+        return self.controller.torque(t, q, v, z) if self.stateful else self.controller(t, q, v)
+
+    def rate(self, t, q, v, z, out):
+        if self.stateful:
+            r = np.asarray(self.controller.state_rate(t, q, v, z), dtype=float)
+            if r.shape != (self.nz,):
+                raise ValueError(f"controller: state_rate returned shape {r.shape} at t = {t}, expected ({self.nz},)")
+            out[:] = r
+
+
 class _Plant:
     """The model's kernel arrays and the Python-driven stages of the integrators."""
 
@@ -95,9 +120,10 @@ class _Plant:
     def rate(self, q, theta, v, out):
         K.rate(self.args[0], q, theta, v, self.R, out)
 
-    def derivative(self, t, q, theta, v, controller, tau, thetadot, a):
-        """``(theta', a)`` into the given arrays; the applied torque into ``tau``."""
-        cmd = controller(t, q, v)
+    def derivative(self, t, q, theta, v, law, z, tau, thetadot, a, zdot):
+        """``(theta', a, z')`` into the given arrays; the applied torque into ``tau``."""
+        law.rate(t, q, v, z, zdot)
+        cmd = law.torque(t, q, v, z)
         if type(cmd) is not np.ndarray or cmd.dtype != np.float64 or cmd.shape != (self.model.nv,):
             cmd = np.asarray(cmd, dtype=float)
             if cmd.shape != (self.model.nv,):
@@ -129,6 +155,9 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             ``model``: model mismatch). Its ``lyapunov(t, q, v)`` (when it has one) and its
             reference ``desired(t) -> (q_d, v_d, a_d)`` are sampled into the trajectory.
             The command is clipped to ``[-model.effort_limit, model.effort_limit]``.
+            A controller with an internal state (``state0`` (nz,), e.g. integral action or
+            parameter estimates) is called as ``torque(t, q, v, z)``, and its state is
+            integrated with the robot from ``z' = state_rate(t, q, v, z)``.
         integrator: ``"rk4"`` (classic 4th-order Runge-Kutta in the manifold chart),
             ``"semi_implicit_euler"`` (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), or a SciPy
             ``solve_ivp`` method (``"RK45"``, ``"DOP853"``, ``"Radau"``, ...), adaptive between
@@ -163,17 +192,17 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))
     A, T = np.empty((n + 1, model.nv)), np.empty((n + 1, model.nv))
     bar = Progress(n, enabled=(n >= PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress)
-    plant = _Plant(model)
+    plant, law = _Plant(model), _Law(controller, model)
+    Z = np.empty((n + 1, law.nz))
+    Z[0] = law.z0
     if controller is None and integrator in INTEGRATORS:
         _run_passive(plant, integrator, q0, v0, dt, t, Q, V, A, T, bar)
+    elif integrator in INTEGRATORS:
+        _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
     else:
-        control = controller if controller is not None else (lambda t_, q_, v_: np.zeros(model.nv))
-        if integrator in INTEGRATORS:
-            _run_fixed_step(plant, integrator, control, q0, v0, dt, t, Q, V, A, T, bar)
-        else:
-            _run_scipy(plant, integrator, control, q0, v0, t, Q, V, A, T, bar, rtol, atol)
+        _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
     bar.close()
-    return _trajectory(model, controller, integrator, t, Q, V, A, T)
+    return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T)
 
 
 def _run_passive(plant, integrator, q0, v0, dt, t, Q, V, A, T, bar):
@@ -192,21 +221,22 @@ def _run_passive(plant, integrator, q0, v0, dt, t, Q, V, A, T, bar):
         bar.update(b)
 
 
-def _run_fixed_step(plant, integrator, control, q0, v0, dt, t, Q, V, A, T, bar):
-    nq, nv = Q.shape[1], V.shape[1]
+def _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar):
+    nq, nv, nz = Q.shape[1], V.shape[1], Z.shape[1]
     n = Q.shape[0] - 1
     zero = np.zeros(nv)
-    theta, qi, vi, tau = np.empty(nv), np.empty(nq), np.empty(nv), np.empty(nv)
-    kt, ka = np.empty((4, nv)), np.empty((4, nv))
+    theta, qi, vi, zi, tau = np.empty(nv), np.empty(nq), np.empty(nv), np.empty(nz), np.empty(nv)
+    kt, ka, kz = np.empty((4, nv)), np.empty((4, nv)), np.empty((4, nz))
     Q[0], V[0] = q0, v0
     every = max(1, n // 100)
     for s in range(n + 1):
-        q, v = Q[s], V[s]
-        plant.derivative(t[s], q, zero, v, control, T[s], kt[0], A[s])
+        q, v, z = Q[s], V[s], Z[s]
+        plant.derivative(t[s], q, zero, v, law, z, T[s], kt[0], A[s], kz[0])
         if s == n:
             break
         if integrator == "semi_implicit_euler":
             V[s + 1] = v + dt * A[s]
+            Z[s + 1] = z + dt * kz[0]
             plant.rate(q, zero, V[s + 1], kt[1])
             plant.point(q, dt * kt[1], Q[s + 1])
         else:
@@ -215,58 +245,65 @@ def _run_fixed_step(plant, integrator, control, q0, v0, dt, t, Q, V, A, T, bar):
                 np.multiply(kt[j - 1], h, out=theta)
                 np.multiply(ka[j - 1], h, out=vi)
                 vi += v
+                np.multiply(kz[j - 1], h, out=zi)
+                zi += z
                 plant.point(q, theta, qi)
-                plant.derivative(t[s] + h, qi, theta, vi, control, tau, kt[j], ka[j])
+                plant.derivative(t[s] + h, qi, theta, vi, law, zi, tau, kt[j], ka[j], kz[j])
             V[s + 1] = v + dt / 6.0 * (ka[0] + 2.0 * ka[1] + 2.0 * ka[2] + ka[3])
+            Z[s + 1] = z + dt / 6.0 * (kz[0] + 2.0 * kz[1] + 2.0 * kz[2] + kz[3])
             plant.point(q, dt / 6.0 * (kt[0] + 2.0 * kt[1] + 2.0 * kt[2] + kt[3]), Q[s + 1])
         if s % every == 0:
             bar.update(s)
 
 
-def _run_scipy(plant, method, control, q0, v0, t, Q, V, A, T, bar, rtol, atol):
-    """``solve_ivp`` on ``(theta, v)`` between consecutive samples, in the chart of the first."""
+def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
+    """``solve_ivp`` on ``(theta, v, z)`` between consecutive samples, in the chart of the first."""
     from scipy.integrate import solve_ivp
 
-    nq, nv = Q.shape[1], V.shape[1]
+    nq, nv, nz = Q.shape[1], V.shape[1], Z.shape[1]
     n = Q.shape[0] - 1
     zero = np.zeros(nv)
-    qi, tau, thetadot, a = np.empty(nq), np.empty(nv), np.empty(nv), np.empty(nv)
+    qi, tau, a = np.empty(nq), np.empty(nv), np.empty(nv)
+    dy = np.empty(2 * nv + nz)
     Q[0], V[0] = q0, v0
     every = max(1, n // 100)
     for s in range(n + 1):
         q = Q[s]
-        plant.derivative(t[s], q, zero, V[s], control, T[s], thetadot, A[s])
+        plant.derivative(t[s], q, zero, V[s], law, Z[s], T[s], dy[:nv], A[s], dy[2 * nv:])
         if s == n:
             break
 
         def f(ti, y, q=q):
-            theta, v = y[:nv], y[nv:]
+            theta = y[:nv]
             plant.point(q, theta, qi)
-            plant.derivative(ti, qi, theta, v, control, tau, thetadot, a)
-            return np.concatenate([thetadot, a])
+            plant.derivative(ti, qi, theta, y[nv:2 * nv], law, y[2 * nv:], tau, dy[:nv], dy[nv:2 * nv], dy[2 * nv:])
+            return dy.copy()
 
-        sol = solve_ivp(f, (t[s], t[s + 1]), np.concatenate([zero, V[s]]), method=method, rtol=rtol, atol=atol)
+        y0 = np.concatenate([zero, V[s], Z[s]])
+        sol = solve_ivp(f, (t[s], t[s + 1]), y0, method=method, rtol=rtol, atol=atol)
         if not sol.success:
             raise ValueError(f"simulate: solve_ivp ({method}) failed between t = {t[s]:.6g} and {t[s + 1]:.6g}: "
                              f"{sol.message}")
         plant.point(q, sol.y[:nv, -1], Q[s + 1])
-        V[s + 1] = sol.y[nv:, -1]
+        V[s + 1] = sol.y[nv:2 * nv, -1]
+        Z[s + 1] = sol.y[2 * nv:, -1]
         if s % every == 0:
             bar.update(s)
 
 
-def _trajectory(model, controller, integrator, t, Q, V, A, T) -> Trajectory:
+def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Trajectory:
     from ..algorithms.energy import kinetic_energy, potential_energy
 
     kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
     potential = potential_energy(model, Q)
     lyapunov = q_d = v_d = None
     if callable(getattr(controller, "lyapunov", None)):
-        lyapunov = np.array([controller.lyapunov(ti, qi, vi) for ti, qi, vi in zip(t, Q, V)], dtype=float)
+        extra = (lambda k: (Z[k],)) if law.stateful else (lambda k: ())
+        lyapunov = np.array([controller.lyapunov(t[k], Q[k], V[k], *extra(k)) for k in range(t.shape[0])], dtype=float)
     if callable(getattr(controller, "desired", None)):
         ref = [controller.desired(ti) for ti in t]
         q_d = np.array([r[0] for r in ref], dtype=float)
         v_d = np.array([r[1] for r in ref], dtype=float)
     return Trajectory(model=model, t=t, q=Q, v=V, a=A, tau=T, kinetic=kinetic, potential=potential,
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
-                      integrator=integrator)
+                      controller_state=Z if law.stateful else None, integrator=integrator)

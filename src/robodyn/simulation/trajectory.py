@@ -49,7 +49,8 @@ class Trajectory:
     ``kinetic``, ``potential``, ``energy`` (N,) with ``energy = kinetic + potential``
     (kinetic energy includes the rotors' ``armature v^2 / 2``); ``lyapunov`` (N,) the
     controller's Lyapunov function or None; ``q_desired``, ``v_desired`` (N, nq) / (N, nv)
-    the controller's reference or None.
+    the controller's reference or None; ``controller_state`` (N, nz) the internal state of a
+    controller that has one (see :func:`robodyn.simulate`), else None.
     """
 
     model: object = field(repr=False)
@@ -64,6 +65,7 @@ class Trajectory:
     lyapunov: np.ndarray | None = None
     q_desired: np.ndarray | None = None
     v_desired: np.ndarray | None = None
+    controller_state: np.ndarray | None = None
     integrator: str = "rk4"
 
     @property
