@@ -223,3 +223,42 @@ def test_bad_controller_state():
     model = planar_2r()
     with pytest.raises(ValueError, match=r"controller: state_rate returned shape \(3,\) at t = 0"):
         rd.simulate(model, [0, 0], [0, 0], 0.01, 1e-3, controller=Broken(model, [0, 0], 1.0, 1.0, 1.0))
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi_implicit_euler"])
+@pytest.mark.parametrize("case", ["pd-gravity", "quintic", "cubic", "sampled"])
+def test_compiled_controllers_match_their_python_law(case, integrator):
+    """PDGravity and ComputedTorque run compiled in simulate; the same law called from Python
+    (wrapped in a lambda) gives the same motion. Plant and controller models differ, both
+    with friction and armature."""
+    from helpers import with_friction_and_armature
+
+    rng = rng_for("compiled", case)
+    plant = with_friction_and_armature(random_model(5, seed=11, branching=0.5), rng, smoothing=0.05)
+    model = plant.with_inertial_parameters(1.1 * plant.inertial_parameters())
+    q0, q1 = rng.uniform(-1, 1, 5), rng.uniform(-1, 1, 5)
+    if case == "pd-gravity":
+        ctrl = control.PDGravity(model, q1, kp=20.0, kd=np.linspace(2.0, 4.0, 5))
+    else:
+        ref = {"quintic": lambda: control.quintic(q0, q1, 0.2, t0=0.05), "cubic": lambda: control.cubic(q0, q1, 0.2),
+               "sampled": lambda: control.Sampled(np.linspace(0.0, 0.25, 6), rng.uniform(-1, 1, (6, 5)))}[case]()
+        ctrl = control.ComputedTorque(model, ref, kp=np.linspace(50.0, 100.0, 5), kd=15.0)
+    assert ctrl.kernel_law() is not None
+    a = rd.simulate(plant, q0, np.zeros(5), 0.3, 1e-3, controller=ctrl, integrator=integrator)
+    b = rd.simulate(plant, q0, np.zeros(5), 0.3, 1e-3, controller=lambda t, q, v: ctrl(t, q, v), integrator=integrator)
+    for key in ("q", "v", "a", "tau"):
+        x, y = getattr(a, key), getattr(b, key)
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-10 * max(1.0, np.abs(y).max()), err_msg=key)
+    assert a.lyapunov is not None and a.q_desired is not None
+    np.testing.assert_allclose(a.tau[7], ctrl(a.t[7], a.q[7], a.v[7]), rtol=1e-12, atol=1e-12)
+
+
+def test_subclasses_with_their_own_law_run_in_python():
+    class Softer(control.PDGravity):
+        def __call__(self, t, q, v):
+            return 0.5 * super().__call__(t, q, v)
+
+    model = planar_2r()
+    assert Softer(model, [0, 0], 1.0, 1.0).kernel_law() is None
+    assert control.ComputedTorque(model, lambda t: (np.zeros(2),) * 3, 1.0, 1.0).kernel_law() is None
+    assert control.SlotineLi(model, control.quintic([0, 0], [1, 1], 1.0), 1.0, 1.0).kernel_law() is None

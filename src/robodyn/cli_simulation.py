@@ -7,7 +7,9 @@
 ``simulate`` starts at rest at ``--q0`` (default: every joint at 0, or mid-range when 0 is
 outside its limits) and drives the robot to ``--target`` (default: ``q0 + 0.5`` rad or m per
 joint, kept inside the limits): ``pd-gravity`` regulates to the target, ``computed-torque``
-tracks a quintic from ``q0`` to the target in the first half of the run. ``--csv`` writes
+tracks a quintic from ``q0`` to the target in the first half of the run. The gains follow
+from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
+so that light wrist joints do not make the closed loop too stiff for the fixed step). ``--csv`` writes
 the trajectory in the format of :mod:`robodyn.simulation.trajectory`, which ``torques``
 reads (or any CSV with a ``t`` column and ``q:<joint>`` columns) to plot the joint forces
 split into inertial, Coriolis/centrifugal and gravity parts.
@@ -61,15 +63,21 @@ def cmd_simulate(args) -> int:
 
     model = load_model(args.model, args.floating_base, args.physical)
     q0, target = start_and_target(model, _vector(args.q0, model.nq, "--q0"), _vector(args.target, model.nv, "--target"))
+    w = args.omega
+    if not (np.isfinite(w) and w > 0):
+        raise ValueError(f"--omega: must be finite and > 0, got {w}")
     if args.controller == "none":
         controller = None
     elif args.controller == "pd-gravity":
-        controller = control.PDGravity(model, target, args.kp, args.kd)
+        from .algorithms.crba import crba
+
+        m = np.diag(crba(model, q0)) if model.nq == model.nv else np.ones(model.nv)
+        controller = control.PDGravity(model, target, w * w * m, 2.0 * w * m)
     else:
         if model.nq != model.nv:
             raise ValueError("--controller computed-torque needs a fixed-base model")
         reference = control.quintic(q0, target, args.duration / 2)
-        controller = control.ComputedTorque(model, reference, args.kp, args.kd)
+        controller = control.ComputedTorque(model, reference, w * w, 2.0 * w)
     traj = simulate(model, q0, np.zeros(model.nv), args.duration, args.dt, controller, args.integrator)
     drift = np.abs(traj.energy - traj.energy[0]).max()
     print(f"robodyn simulate {model.name!r}: {traj.t.shape[0] - 1} steps of {args.dt:g} s ({args.integrator}), "
@@ -124,8 +132,9 @@ def add_commands(sub, common) -> None:
     p.add_argument("--integrator", choices=INTEGRATORS + SCIPY_INTEGRATORS, default="rk4")
     p.add_argument("--q0", help="initial configuration, comma-separated (default: see the module doc)")
     p.add_argument("--target", help="target joint positions, comma-separated (default q0 + 0.5)")
-    p.add_argument("--kp", type=float, default=100.0, help="proportional gain (default 100)")
-    p.add_argument("--kd", type=float, default=20.0, help="derivative gain (default 20)")
+    p.add_argument("--omega", type=float, default=10.0,
+                   help="closed-loop natural frequency w, rad/s (default 10), critically damped: computed torque "
+                        "Kp = w^2, Kd = 2 w; pd-gravity Kp = w^2 m_jj, Kd = 2 w m_jj with m_jj = diag M(q0)")
     p.add_argument("--plot", help="PNG: joints, tracking errors, torques, energy and Lyapunov function")
     p.add_argument("--gif", help="GIF animation of the robot as a stick figure")
     p.add_argument("--fps", type=int, default=20, help="frames per second of the GIF (default 20)")

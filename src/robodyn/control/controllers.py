@@ -70,6 +70,11 @@ class Controller:
     def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
         raise NotImplementedError(f"{type(self).__name__} does not define its control law")
 
+    def kernel_law(self):
+        """``(law code, gains (2, nv), breaks, coefs)`` when :func:`robodyn.simulate` can run
+        this controller in compiled code (``simulation._kernels.law_torque``), else None."""
+        return None
+
 
 def _reference(model, reference):
     if not callable(reference):
@@ -100,6 +105,13 @@ class PDGravity(Controller):
 
     def desired(self, t):
         return self.q_d, self._zero, self._zero
+
+    def kernel_law(self):
+        if type(self).__call__ is not PDGravity.__call__:
+            return None
+        from ..simulation._kernels import PD_GRAVITY
+
+        return PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
 
     def lyapunov(self, t, q, v):
         e = self.q_d - q
@@ -151,6 +163,15 @@ class ComputedTorque(Controller):
     def __call__(self, t, q, v):
         q_d, v_d, a_d = self.reference(t)
         return rnea(self.model, q, v, a_d + self.kd * (v_d - v) + self.kp * (q_d - q))
+
+    def kernel_law(self):
+        piecewise = getattr(self.reference, "piecewise_polynomial", None)
+        if type(self).__call__ is not ComputedTorque.__call__ or piecewise is None:
+            return None
+        from ..simulation._kernels import COMPUTED_TORQUE
+
+        breaks, coefs = piecewise()
+        return COMPUTED_TORQUE, np.stack([self.kp, self.kd]), breaks, coefs
 
     def desired(self, t):
         return self.reference(t)

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
+# Coefficients of s(tau), lowest power first.
+_POLYNOMIALS = {"cubic": (0.0, 0.0, 3.0, -2.0), "quintic": (0.0, 0.0, 0.0, 10.0, -15.0, 6.0)}
 _SCALINGS = {
     # s(tau), s'(tau), s''(tau)
     "cubic": (lambda x: 3 * x ** 2 - 2 * x ** 3, lambda x: 6 * x - 6 * x ** 2, lambda x: 6 - 12 * x),
@@ -63,6 +65,14 @@ class PointToPoint:
             return (self.q0 if x < 0.0 else self.q1).copy(), np.zeros_like(d), np.zeros_like(d)
         return self.q0 + s(x) * d, ds(x) / self.duration * d, dds(x) / self.duration ** 2 * d
 
+    def piecewise_polynomial(self):
+        """``(breaks (2,), coefs (k, 1, n))`` in scipy's ``PPoly`` layout (highest power of
+        ``t - t0`` first), for the compiled controllers."""
+        a = np.array(_POLYNOMIALS[self.profile]) / self.duration ** np.arange(len(_POLYNOMIALS[self.profile]))
+        coefs = a[:, None] * (self.q1 - self.q0)[None, :]
+        coefs[0] += self.q0
+        return np.array([self.t0, self.t0 + self.duration]), np.ascontiguousarray(coefs[::-1, None, :])
+
 
 def cubic(q0, q1, duration: float, t0: float = 0.0) -> PointToPoint:
     """Cubic rest-to-rest reference (zero velocity at both ends)."""
@@ -93,10 +103,14 @@ class Sampled:
         self.spline = CubicSpline(self.t, q, axis=0)
 
     def __call__(self, t: float):
-        if t <= self.t[0] or t >= self.t[-1]:
+        if t < self.t[0] or t > self.t[-1]:
             z = np.zeros(self.q.shape[1])
-            return (self.q[0] if t <= self.t[0] else self.q[-1]).copy(), z, z.copy()
+            return (self.q[0] if t < self.t[0] else self.q[-1]).copy(), z, z.copy()
         return self.spline(t), self.spline(t, 1), self.spline(t, 2)
+
+    def piecewise_polynomial(self):
+        """``(breaks (N,), coefs (4, N - 1, n))`` of the spline (scipy's ``PPoly`` layout)."""
+        return np.ascontiguousarray(self.spline.x), np.ascontiguousarray(self.spline.c)
 
     @classmethod
     def from_csv(cls, model, path) -> "Sampled":

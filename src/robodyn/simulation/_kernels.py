@@ -22,11 +22,18 @@ from .._jit import inline, kernel
 from ..algorithms._inputs import OK
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
+from ..algorithms.rnea import rnea_one
+from ..algorithms.rnea import workspace as rnea_workspace
 from ..joints import FREE
 from ..spatial import rotation_from_quaternion
 
 SEMI_IMPLICIT_EULER = 0
 RK4 = 1
+
+# Control laws run in compiled code (``robodyn.control`` controllers' ``kernel_law``).
+CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
+PD_GRAVITY = 1       # Kp (q_d - q) - Kd qd + g(q)
+COMPUTED_TORQUE = 2  # rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))
 
 
 @inline
@@ -108,14 +115,69 @@ def stage(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, tau, thet
     return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, True, tau, thetadot, a, R, ws)
 
 
+@inline
+def reference_at(breaks, coefs, t, qd, vd, ad):
+    """Piecewise polynomial reference (scipy ``PPoly`` layout: ``coefs[i, seg, j]`` multiplies
+    ``(t - breaks[seg])^(k - 1 - i)``) and its two derivatives at ``t``; outside
+    ``[breaks[0], breaks[-1]]`` it holds its end value at rest."""
+    m, k = breaks.shape[0] - 1, coefs.shape[0]
+    hold = t < breaks[0] or t > breaks[m]
+    if t < breaks[0]:
+        seg, x = 0, 0.0
+    else:
+        lo, hi = 0, m - 1  # the last segment with breaks[seg] <= t
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if breaks[mid] <= t:
+                lo = mid
+            else:
+                hi = mid - 1
+        seg = lo
+        x = min(t, breaks[m]) - breaks[seg]
+    for j in range(coefs.shape[2]):
+        p, dp, ddp = 0.0, 0.0, 0.0
+        for i in range(k):  # Horner's rule with the first two derivatives
+            ddp = ddp * x + 2.0 * dp
+            dp = dp * x + p
+            p = p * x + coefs[i, seg, j]
+        qd[j] = p
+        vd[j] = 0.0 if hold else dp
+        ad[j] = 0.0 if hold else ddp
+
+
+@inline
+def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
+    """The command of a compiled control law at ``(t, q, v)`` into ``out``; returns a status.
+
+    ``c = (ints, body, dofs_gravity, dofs_full, params, zero_wrench)`` of the controller's model
+    (``dofs_gravity`` without friction and armature, ``dofs_full`` with them);
+    ``gains[0] = Kp``, ``gains[1] = Kd``."""
+    if law == CONSTANT:
+        for k in range(out.shape[0]):
+            out[k] = tau_cmd[k]
+        return OK
+    ws, qd, vd, ad, acc, zero = cws
+    reference_at(breaks, coefs, t, qd, vd, ad)
+    if law == PD_GRAVITY:
+        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], -1, True, out, ws)
+        for k in range(out.shape[0]):
+            out[k] += gains[0, k] * (qd[k] - q[k]) - gains[1, k] * v[k]
+        return st
+    for k in range(out.shape[0]):
+        acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
+    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], -1, True, out, ws)
+
+
 @kernel
-def run_passive(ints, body, dofs, params, fext, limit, tau_cmd, method, q0, v0, dt, Q, V, A, T):
-    """Integrate with a constant command ``tau_cmd`` (zero: the free robot) from ``(q0, v0)``
-    with ``Q.shape[0] - 1`` steps of ``dt``; writes the samples ``Q, V``, the accelerations
-    ``A`` and the applied torques ``T`` at the samples. Returns ``(status, sample)``: the ABA
-    status of the first failing evaluation and its sample index (``(OK, -1)`` on success)."""
+def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, t0, dt,
+        Q, V, A, T):
+    """Integrate from ``(q0, v0)`` at time ``t0`` with ``Q.shape[0] - 1`` steps of ``dt`` under
+    a compiled control law (``law``, see ``law_torque``; ``CONSTANT`` applies ``tau_cmd``);
+    writes the samples ``Q, V``, the accelerations ``A`` and the applied torques ``T``.
+    Returns ``(status, sample)`` of the first failing evaluation (``(OK, -1)`` on success)."""
     nv = v0.shape[0]
     ws, R = stage_workspace(ints.shape[0], q0.shape[0], nv)
+    cws = (rnea_workspace(c[0].shape[0]), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv))
     th = np.zeros(nv)
     thi = np.empty(nv)
     vi = np.empty(nv)
@@ -123,13 +185,16 @@ def run_passive(ints, body, dofs, params, fext, limit, tau_cmd, method, q0, v0, 
     ka = np.empty((4, nv))
     kt = np.empty((4, nv))
     tau = np.empty(nv)
+    cmd = np.empty(nv)
     Q[0, :] = q0
     V[0, :] = v0
     n = Q.shape[0] - 1
     for s in range(n + 1):
-        q, v = Q[s], V[s]
+        q, v, t = Q[s], V[s], t0 + s * dt
         th[:] = 0.0
-        st = derivative(ints, body, dofs, params, fext, limit, q, th, v, tau_cmd, True, T[s], kt[0], A[s], R, ws)
+        st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, cmd)
+        if st == OK:
+            st = derivative(ints, body, dofs, params, fext, limit, q, th, v, cmd, True, T[s], kt[0], A[s], R, ws)
         if st != OK:
             return st, s
         if s == n:
@@ -149,7 +214,9 @@ def run_passive(ints, body, dofs, params, fext, limit, tau_cmd, method, q0, v0, 
                 thi[k] = h * kt[j - 1, k]
                 vi[k] = v[k] + h * ka[j - 1, k]
             chart_point(ints, q, thi, qi)
-            st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, tau_cmd, True, tau, kt[j], ka[j], R, ws)
+            st = law_torque(law, c, gains, breaks, coefs, t + h, qi, vi, tau_cmd, cws, cmd)
+            if st == OK:
+                st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, cmd, True, tau, kt[j], ka[j], R, ws)
             if st != OK:
                 return st, s
         for k in range(nv):

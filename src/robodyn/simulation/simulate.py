@@ -168,7 +168,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Returns:
         :class:`Trajectory` (t, q, v, a, tau, energies, Lyapunov function, reference).
 
-    Without controller the fixed-step integrators run entirely in compiled code.
+    Without controller, and with the built-in :class:`robodyn.control.PDGravity` and
+    :class:`robodyn.control.ComputedTorque` (on a ``cubic``/``quintic``/``Sampled``
+    reference), the fixed-step integrators run entirely in compiled code; other callables
+    are called from a Python loop.
     Reference: Hairer, Lubich, Wanner, *Geometric Numerical Integration* (2006), IV.8
     (Runge-Kutta methods in local charts of a manifold).
     """
@@ -195,8 +198,11 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     plant, law = _Plant(model), _Law(controller, model)
     Z = np.empty((n + 1, law.nz))
     Z[0] = law.z0
-    if controller is None and integrator in INTEGRATORS:
-        _run_passive(plant, integrator, q0, v0, dt, t, Q, V, A, T, bar)
+    compiled = None
+    if integrator in INTEGRATORS and not law.stateful:
+        compiled = (K.CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
+    if compiled is not None:
+        _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
     elif integrator in INTEGRATORS:
         _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
     else:
@@ -205,19 +211,34 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T)
 
 
-def _run_passive(plant, integrator, q0, v0, dt, t, Q, V, A, T, bar):
-    """Compiled runs, in pieces of about 1% of the run when the progress bar is shown."""
+def _kernel_law(controller):
+    """The compiled form of a built-in controller (``kernel_law``), with its model's arrays."""
+    spec = getattr(controller, "kernel_law", None)
+    spec = spec() if callable(spec) else None
+    return None if spec is None else (spec[0], controller.model, *spec[1:])
+
+
+def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
+    """Compiled runs (no controller, or a built-in one), in pieces of about 1% of the run
+    when the progress bar is shown."""
+    law, cmodel, gains, breaks, coefs = compiled
+    model = plant.model
+    nv = model.nv
+    if law == K.CONSTANT:
+        cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
+    k = cmodel._kernel
+    c = (k["ints"], k["body"], k["dofs"][False, False], k["dofs"][True, True], k["params"][True], k["zero_wrench"])
     n = Q.shape[0] - 1
     method = K.RK4 if integrator == "rk4" else K.SEMI_IMPLICIT_EULER
-    zero = np.zeros(plant.model.nv)
+    zero = np.zeros(nv)
     piece = max(1, n // 100) if bar.enabled else n
     Q[0], V[0] = q0, v0
     for a in range(0, n, piece):
         b = min(n, a + piece)
-        status, s = K.run_passive(*plant.args, zero, method, Q[a].copy(), V[a].copy(), dt, Q[a:b + 1], V[a:b + 1],
-                                  A[a:b + 1], T[a:b + 1])
+        status, s = K.run(*plant.args, c, law, gains, breaks, coefs, zero, method, Q[a].copy(), V[a].copy(), t[a],
+                          dt, Q[a:b + 1], V[a:b + 1], A[a:b + 1], T[a:b + 1])
         if status != OK:
-            _raise(plant.model, status, t[a + s], Q[a + s], V[a + s], zero)
+            _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
         bar.update(b)
 
 
