@@ -113,9 +113,12 @@ class PDGravity(Controller):
 
         return PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
 
+    #: ``lyapunov`` also takes batches ``q``, ``v`` (N, nv) (``t`` is not used).
+    lyapunov_vectorized = True
+
     def lyapunov(self, t, q, v):
         e = self.q_d - q
-        return 0.5 * v @ crba(self.model, q) @ v + 0.5 * e @ (self.kp * e)
+        return 0.5 * np.einsum("...i,...ij,...j->...", v, crba(self.model, q), v) + 0.5 * np.sum(self.kp * e * e, -1)
 
 
 class PIDGravity(PDGravity):
@@ -132,6 +135,7 @@ class PIDGravity(PDGravity):
     """
 
     lyapunov = None
+    lyapunov_vectorized = False
 
     def __init__(self, model, q_desired, kp, ki, kd):
         super().__init__(model, q_desired, kp, kd)

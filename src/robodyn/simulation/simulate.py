@@ -320,7 +320,11 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Traject
     lyapunov = q_d = v_d = None
     if callable(getattr(controller, "lyapunov", None)):
         extra = (lambda k: (Z[k],)) if law.stateful else (lambda k: ())
-        lyapunov = np.array([controller.lyapunov(t[k], Q[k], V[k], *extra(k)) for k in range(t.shape[0])], dtype=float)
+        if getattr(controller, "lyapunov_vectorized", False) and not law.stateful:
+            lyapunov = np.asarray(controller.lyapunov(t, Q, V), dtype=float)
+        else:
+            lyapunov = np.array([controller.lyapunov(t[k], Q[k], V[k], *extra(k)) for k in range(t.shape[0])],
+                                dtype=float)
     if callable(getattr(controller, "desired", None)):
         ref = [controller.desired(ti) for ti in t]
         q_d = np.array([r[0] for r in ref], dtype=float)
