@@ -262,3 +262,20 @@ def test_subclasses_with_their_own_law_run_in_python():
     assert Softer(model, [0, 0], 1.0, 1.0).kernel_law() is None
     assert control.ComputedTorque(model, lambda t: (np.zeros(2),) * 3, 1.0, 1.0).kernel_law() is None
     assert control.SlotineLi(model, control.quintic([0, 0], [1, 1], 1.0), 1.0, 1.0).kernel_law() is None
+
+
+@pytest.mark.parametrize("make", [lambda m: control.PDGravity(m, [0.3, -0.2], [50.0, 20.0], [10.0, 5.0]),
+                                  lambda m: control.ComputedTorque(m, control.cubic([0, 0], [1, -1], 0.3), 30.0, 9.0),
+                                  lambda m: control.SlotineLi(m, control.Sampled([0, 0.1, 0.3], [[0, 0], [0.2, 0.1],
+                                                                                                 [0.5, -0.4]]), 3.0, 5.0)],
+                         ids=["pd-gravity", "computed-torque", "slotine-li"])
+def test_lyapunov_and_reference_of_a_whole_trajectory(make):
+    """The vectorized evaluation after a run equals the evaluation sample by sample."""
+    model = planar_2r()
+    ctrl = make(model)
+    assert ctrl.vectorized
+    traj = rd.simulate(model, [0.1, 0.1], [0.0, 0.0], 0.4, 2e-3, controller=ctrl)
+    one_by_one = [ctrl.lyapunov(t, q, v) for t, q, v in zip(traj.t, traj.q, traj.v)]
+    np.testing.assert_allclose(traj.lyapunov, one_by_one, rtol=1e-12, atol=1e-300)
+    np.testing.assert_allclose(traj.q_desired, [ctrl.desired(t)[0] for t in traj.t], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(traj.v_desired, [ctrl.desired(t)[1] for t in traj.t], rtol=0, atol=1e-12)

@@ -30,6 +30,7 @@ from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
 from ..algorithms._inputs import raise_for_status
 from . import _kernels
+from .references import PointToPoint, Sampled
 from ..algorithms.rnea import rnea
 from ..algorithms.terms import gravity
 
@@ -60,6 +61,9 @@ class Controller:
     desired = None
     #: Initial internal state (nz,) of a controller that has one, else None.
     state0 = None
+    #: True when ``lyapunov(t, q, v)`` and ``desired(t)`` also take a whole trajectory:
+    #: ``t`` (N,), ``q``, ``v`` (N, nv) (evaluated at once after a simulation).
+    vectorized = False
 
     def __init__(self, model):
         if model.nq != model.nv:
@@ -104,6 +108,9 @@ class PDGravity(Controller):
         return self.kp * (self.q_d - q) - self.kd * v + gravity(self.model, q)
 
     def desired(self, t):
+        if np.ndim(t):
+            shape = (np.shape(t)[0], self.model.nv)
+            return np.broadcast_to(self.q_d, shape).copy(), np.zeros(shape), np.zeros(shape)
         return self.q_d, self._zero, self._zero
 
     def kernel_law(self):
@@ -113,8 +120,7 @@ class PDGravity(Controller):
 
         return PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
 
-    #: ``lyapunov`` also takes batches ``q``, ``v`` (N, nv) (``t`` is not used).
-    lyapunov_vectorized = True
+    vectorized = True
 
     def lyapunov(self, t, q, v):
         e = self.q_d - q
@@ -135,7 +141,7 @@ class PIDGravity(PDGravity):
     """
 
     lyapunov = None
-    lyapunov_vectorized = False
+    vectorized = False
 
     def __init__(self, model, q_desired, kp, ki, kd):
         super().__init__(model, q_desired, kp, kd)
@@ -180,10 +186,14 @@ class ComputedTorque(Controller):
     def desired(self, t):
         return self.reference(t)
 
+    @property
+    def vectorized(self):
+        return isinstance(self.reference, (PointToPoint, Sampled))
+
     def lyapunov(self, t, q, v):
         q_d, v_d, _ = self.reference(t)
         e, ed = q_d - q, v_d - v
-        return 0.5 * ed @ ed + 0.5 * e @ (self.kp * e)
+        return 0.5 * np.sum(ed * ed, -1) + 0.5 * np.sum(self.kp * e * e, -1)
 
 
 class TaskSpacePD(Controller):
@@ -270,6 +280,10 @@ class SlotineLi(Controller):
     def desired(self, t):
         return self.reference(t)
 
+    @property
+    def vectorized(self):
+        return isinstance(self.reference, (PointToPoint, Sampled))
+
     def lyapunov(self, t, q, v):
         e, _, _, s = self.sliding(t, q, v)
-        return 0.5 * s @ crba(self.model, q) @ s + e @ (self.lam * self.kd * e)
+        return 0.5 * np.einsum("...i,...ij,...j->...", s, crba(self.model, q), s) + np.sum(self.lam * self.kd * e * e, -1)

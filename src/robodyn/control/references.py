@@ -7,6 +7,7 @@
 * :class:`Sampled`: samples ``(t_k, q_k)`` (e.g. a CSV file) interpolated by a cubic spline
   (not-a-knot end conditions; scipy's ``CubicSpline``).
 
+References take a time or an array of times (then each output is (N, n)).
 Before the start and after the end a reference holds its first / last position at rest
 (a point-to-point reference gives its polynomial's values on the closed interval, so the
 cubic's acceleration jumps at both ends: fixed-step integrators are most accurate with the
@@ -57,13 +58,20 @@ class PointToPoint:
             raise ValueError(f"t0: must be finite, got {t0}")
         self.duration, self.t0, self.profile = float(duration), float(t0), profile
 
-    def __call__(self, t: float):
-        x = (t - self.t0) / self.duration
+    def __call__(self, t):
+        """``(q_d, qd_d, qdd_d)`` at ``t``: each (n,) for a scalar ``t``, (N, n) for ``t`` (N,)."""
         s, ds, dds = _SCALINGS[self.profile]
         d = self.q1 - self.q0
-        if x < 0.0 or x > 1.0:  # at rest outside the motion
-            return (self.q0 if x < 0.0 else self.q1).copy(), np.zeros_like(d), np.zeros_like(d)
-        return self.q0 + s(x) * d, ds(x) / self.duration * d, dds(x) / self.duration ** 2 * d
+        if np.ndim(t) == 0:
+            x = (t - self.t0) / self.duration
+            if x < 0.0 or x > 1.0:  # at rest outside the motion
+                return (self.q0 if x < 0.0 else self.q1).copy(), np.zeros_like(d), np.zeros_like(d)
+            return self.q0 + s(x) * d, ds(x) / self.duration * d, dds(x) / self.duration ** 2 * d
+        x = (np.asarray(t, dtype=float)[:, None] - self.t0) / self.duration
+        inside = (x >= 0.0) & (x <= 1.0)
+        x = np.clip(x, 0.0, 1.0)
+        return (self.q0 + s(x) * d, np.where(inside, ds(x) / self.duration * d, 0.0),
+                np.where(inside, dds(x) / self.duration ** 2 * d, 0.0))
 
     def piecewise_polynomial(self):
         """``(breaks (2,), coefs (k, 1, n))`` in scipy's ``PPoly`` layout (highest power of
@@ -102,11 +110,17 @@ class Sampled:
         self.q = q
         self.spline = CubicSpline(self.t, q, axis=0)
 
-    def __call__(self, t: float):
-        if t < self.t[0] or t > self.t[-1]:
-            z = np.zeros(self.q.shape[1])
-            return (self.q[0] if t < self.t[0] else self.q[-1]).copy(), z, z.copy()
-        return self.spline(t), self.spline(t, 1), self.spline(t, 2)
+    def __call__(self, t):
+        """``(q_d, qd_d, qdd_d)`` at ``t``: each (n,) for a scalar ``t``, (N, n) for ``t`` (N,)."""
+        if np.ndim(t) == 0:
+            if t < self.t[0] or t > self.t[-1]:
+                z = np.zeros(self.q.shape[1])
+                return (self.q[0] if t < self.t[0] else self.q[-1]).copy(), z, z.copy()
+            return self.spline(t), self.spline(t, 1), self.spline(t, 2)
+        t = np.asarray(t, dtype=float)
+        tc = np.clip(t, self.t[0], self.t[-1])
+        inside = ((t >= self.t[0]) & (t <= self.t[-1]))[:, None]
+        return self.spline(tc), np.where(inside, self.spline(tc, 1), 0.0), np.where(inside, self.spline(tc, 2), 0.0)
 
     def piecewise_polynomial(self):
         """``(breaks (N,), coefs (4, N - 1, n))`` of the spline (scipy's ``PPoly`` layout)."""

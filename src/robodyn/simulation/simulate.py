@@ -318,17 +318,21 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Traject
     kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
     potential = potential_energy(model, Q)
     lyapunov = q_d = v_d = None
+    vectorized = getattr(controller, "vectorized", False) and not law.stateful
     if callable(getattr(controller, "lyapunov", None)):
-        extra = (lambda k: (Z[k],)) if law.stateful else (lambda k: ())
-        if getattr(controller, "lyapunov_vectorized", False) and not law.stateful:
+        if vectorized:
             lyapunov = np.asarray(controller.lyapunov(t, Q, V), dtype=float)
         else:
+            extra = (lambda k: (Z[k],)) if law.stateful else (lambda k: ())
             lyapunov = np.array([controller.lyapunov(t[k], Q[k], V[k], *extra(k)) for k in range(t.shape[0])],
                                 dtype=float)
     if callable(getattr(controller, "desired", None)):
-        ref = [controller.desired(ti) for ti in t]
-        q_d = np.array([r[0] for r in ref], dtype=float)
-        v_d = np.array([r[1] for r in ref], dtype=float)
+        if vectorized:
+            q_d, v_d, _ = (np.asarray(x, dtype=float) for x in controller.desired(t))
+        else:
+            ref = [controller.desired(ti) for ti in t]
+            q_d = np.array([r[0] for r in ref], dtype=float)
+            v_d = np.array([r[1] for r in ref], dtype=float)
     return Trajectory(model=model, t=t, q=Q, v=V, a=A, tau=T, kinetic=kinetic, potential=potential,
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
                       controller_state=Z if law.stateful else None, integrator=integrator)
