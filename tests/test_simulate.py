@@ -256,6 +256,10 @@ def test_bad_input():
         call(controller=lambda t, q, v: np.zeros(3))
     with pytest.raises(ValueError, match=r"tau \(controller output\) contains NaN"):
         call(controller=lambda t, q, v: np.array([0.0, np.nan]) if t > 0.05 else np.zeros(2))
+    from robodyn import control
+
+    with pytest.raises(ValueError, match=r"controller: its model has nq=7, nv=7; the simulated model has nq=2"):
+        call(controller=control.PDGravity(rd.models.load("panda"), np.zeros(7), 1.0, 1.0))
     floating = random_model(2, seed=0, floating_base=True)
     q0, v0, _ = random_state(floating, rng_for("quat"))
     q0[3:7] *= 1.5

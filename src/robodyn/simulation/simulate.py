@@ -184,6 +184,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
         raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS + SCIPY_INTEGRATORS}")
     if controller is not None and not callable(controller):
         raise ValueError(f"controller: expected None or a callable (t, q, v) -> tau, got {type(controller).__name__}")
+    cmodel = getattr(controller, "model", None)
+    if cmodel is not None and (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
+        raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
+                         f"nq={model.nq}, nv={model.nv}")
     for i in np.flatnonzero(model.joint_type == J.FREE):
         k = model.idx_q[i] + 3
         n = np.linalg.norm(q0[k:k + 4])
@@ -193,7 +197,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
     Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))
-    A, T = np.empty((n + 1, model.nv)), np.empty((n + 1, model.nv))
+    A, T = np.zeros((n + 1, model.nv)), np.zeros((n + 1, model.nv))
     bar = Progress(n, enabled=(n >= PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress)
     plant, law = _Plant(model), _Law(controller, model)
     Z = np.empty((n + 1, law.nz))
