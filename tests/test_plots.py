@@ -120,3 +120,12 @@ def test_import_robodyn_does_not_load_matplotlib():
     code = "import sys, robodyn; robodyn.simulate; robodyn.control; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_floating_base_is_not_tied_to_the_world():
+    model = rd.random.random_model(4, seed=3, floating_base=True)
+    q = rd.random.random_configuration(model, rng_for("stick"), 2)
+    points, segments = plots.stick_points(model, q)
+    assert points.shape == (2, 1 + model.nbodies + int(np.sum(model.frame_body >= 0)), 3)
+    assert all(0 not in seg for seg in segments)
+    assert len(segments) == model.nbodies - 1

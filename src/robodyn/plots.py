@@ -158,8 +158,8 @@ def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     """World points (N, P, 3) of the stick figure and its segments ``(i, j)``.
 
     Points: the world origin, every body origin (its joint), every named frame fixed to a
-    body (e.g. the tool flange). Segments join each body origin to its parent's (the root to
-    the world origin) and each frame to its body.
+    body (e.g. the tool flange). Segments join each body origin to its parent's (a fixed root
+    to the world origin) and each frame to its body.
     """
     from .algorithms.kinematics import forward_kinematics
 
@@ -167,7 +167,10 @@ def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     nb = model.nbodies
     frames = [k for k in range(len(model.frame_names)) if model.frame_body[k] >= 0]
     pts = [np.zeros((T.shape[0], 3)), *(T[:, i, :3, 3] for i in range(nb))]
-    segments = [(0 if model.parent[i] < 0 else model.parent[i] + 1, i + 1) for i in range(nb)]
+    from .joints import FREE
+
+    segments = [(0 if model.parent[i] < 0 else model.parent[i] + 1, i + 1) for i in range(nb)
+                if not (model.parent[i] < 0 and model.joint_type[i] == FREE)]  # a floating base flies free
     for k in frames:
         b = model.frame_body[k]
         pts.append(T[:, b, :3, 3] + T[:, b, :3, :3] @ model.frame_p[k])
