@@ -26,6 +26,12 @@ def test_simulate_then_torques(tmp_path, capsys):
     assert main(["torques", "planar_2r", str(csv), "--plot", str(contributions)]) == 0
     assert contributions.stat().st_size > 0
     assert "max|coriolis|" in capsys.readouterr().out
+    # the CSV as a reference to track
+    tracked = tmp_path / "tracked.csv"
+    assert main(["simulate", "planar_2r", "--controller", "computed-torque", "--duration", "0.2", "--reference",
+                 str(csv), "--csv", str(tracked)]) == 0
+    _, q_tracked, _, _ = read_csv(model, tracked)
+    np.testing.assert_allclose(q_tracked, q[:201], rtol=0, atol=1e-6)
 
 
 @pytest.mark.parametrize("controller", ["none", "pd-gravity"])
@@ -51,6 +57,8 @@ def test_errors(tmp_path, capsys):
     assert e.value.code == 2
     assert main(["simulate", "planar_2r", "--q0", "1,2,3"]) == 2
     assert "--q0: expected 2 comma-separated numbers, got 3" in capsys.readouterr().err
+    assert main(["simulate", "planar_2r", "--reference", "x.csv"]) == 2
+    assert "--reference applies to --controller computed-torque" in capsys.readouterr().err
     assert main(["simulate", "planar_2r", "--dt", "0"]) == 2
     assert "dt: must be finite and > 0" in capsys.readouterr().err
     (tmp_path / "bad.csv").write_text("t,q:joint1\n0,1\n1,2\n")

@@ -7,7 +7,8 @@
 ``simulate`` starts at rest at ``--q0`` (default: every joint at 0, or mid-range when 0 is
 outside its limits) and drives the robot to ``--target`` (default: ``q0 + 0.5`` rad or m per
 joint, kept inside the limits): ``pd-gravity`` regulates to the target, ``computed-torque``
-tracks a quintic from ``q0`` to the target in the first half of the run. The gains follow
+tracks a quintic from ``q0`` to the target in the first half of the run, or the trajectory
+of a CSV file given with ``--reference`` (interpolated by a cubic spline). The gains follow
 from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
 so that light wrist joints do not make the closed loop too stiff for the fixed step). ``--csv`` writes
 the trajectory in the format of :mod:`robodyn.simulation.trajectory`, which ``torques``
@@ -62,7 +63,14 @@ def cmd_simulate(args) -> int:
     from .cli import load_model
 
     model = load_model(args.model, args.floating_base, args.physical)
-    q0, target = start_and_target(model, _vector(args.q0, model.nq, "--q0"), _vector(args.target, model.nv, "--target"))
+    if args.reference and args.controller != "computed-torque":
+        raise ValueError("--reference applies to --controller computed-torque")
+    q_start = _vector(args.q0, model.nq, "--q0")
+    if args.reference and q_start is None:
+        from .simulation.trajectory import read_csv
+
+        q_start = read_csv(model, args.reference)[1][0]
+    q0, target = start_and_target(model, q_start, _vector(args.target, model.nv, "--target"))
     w = args.omega
     if not (np.isfinite(w) and w > 0):
         raise ValueError(f"--omega: must be finite and > 0, got {w}")
@@ -76,7 +84,10 @@ def cmd_simulate(args) -> int:
     else:
         if model.nq != model.nv:
             raise ValueError("--controller computed-torque needs a fixed-base model")
-        reference = control.quintic(q0, target, args.duration / 2)
+        if args.reference:
+            reference = control.Sampled.from_csv(model, args.reference)
+        else:
+            reference = control.quintic(q0, target, args.duration / 2)
         controller = control.ComputedTorque(model, reference, w * w, 2.0 * w)
     traj = simulate(model, q0, np.zeros(model.nv), args.duration, args.dt, controller, args.integrator)
     drift = np.abs(traj.energy - traj.energy[0]).max()
@@ -132,6 +143,8 @@ def add_commands(sub, common) -> None:
     p.add_argument("--integrator", choices=INTEGRATORS + SCIPY_INTEGRATORS, default="rk4")
     p.add_argument("--q0", help="initial configuration, comma-separated (default: see the module doc)")
     p.add_argument("--target", help="target joint positions, comma-separated (default q0 + 0.5)")
+    p.add_argument("--reference", help="computed-torque: track this trajectory CSV (t and q:<joint> columns, "
+                                       "cubic spline) instead of the quintic; starts at its first sample")
     p.add_argument("--omega", type=float, default=10.0,
                    help="closed-loop natural frequency w, rad/s (default 10), critically damped: computed torque "
                         "Kp = w^2, Kd = 2 w; pd-gravity Kp = w^2 m_jj, Kd = 2 w m_jj with m_jj = diag M(q0)")
