@@ -26,13 +26,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..algorithms._inputs import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
-from ..algorithms._inputs import raise_for_status
-from . import _kernels
-from .references import PointToPoint, Sampled
 from ..algorithms.rnea import rnea
 from ..algorithms.terms import gravity
+from . import _kernels
+from .references import PointToPoint, Sampled
 
 
 def gain(name: str, value, n: int) -> np.ndarray:
@@ -252,7 +252,9 @@ class SlotineLi(Controller):
     (:meth:`feedforward` computes the model terms as ``rnea(q, qd, qdd_r) - C(q, qd) s``.)
     The closed loop ``M s' + (C + Kd) s = 0`` uses the skew-symmetry of ``Mdot - 2C``:
     ``V = s^T M s / 2 + q~^T Lambda Kd q~`` has ``dV/dt = -q~'^T Kd q~' - q~^T Lambda Kd Lambda q~``.
-    An adaptive version replaces :meth:`feedforward` by ``Y(q, qd, qd_r, qdd_r) theta_hat``.
+    An adaptive version replaces :meth:`feedforward` by ``Y(q, qd, qd_r, qdd_r) theta_hat``
+    with the estimates ``theta_hat`` as internal state (``state0``, ``torque(t, q, v, z)``,
+    ``state_rate = -Gamma Y^T s``; see :class:`Controller`).
     Spong et al. (2006), section 8.5.
     """
 
