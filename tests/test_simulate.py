@@ -226,6 +226,12 @@ def test_progress_bar_of_a_run(capfd):
     b = rd.simulate(model, [0.3], [0.0], 0.2, 1e-3)
     assert "100%" in capfd.readouterr().err
     np.testing.assert_array_equal(a.q, b.q)  # computed in pieces, same result
+    from robodyn import control
+
+    ct = control.ComputedTorque(model, control.quintic([0.3], [0.0], 0.1, t0=0.05), 100.0, 20.0)
+    a = rd.simulate(model, [0.3], [0.0], 0.2, 1e-3, controller=ct, progress=True)
+    b = rd.simulate(model, [0.3], [0.0], 0.2, 1e-3, controller=ct)
+    np.testing.assert_array_equal(a.q, b.q)  # the pieces restart at the right time
 
 
 def test_bad_input():
