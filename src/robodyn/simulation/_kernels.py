@@ -169,9 +169,9 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
 
 
 @kernel
-def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, t0, dt,
+def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, s0, dt,
         Q, V, A, T):
-    """Integrate from ``(q0, v0)`` at time ``t0`` with ``Q.shape[0] - 1`` steps of ``dt`` under
+    """Integrate from ``(q0, v0)`` at time ``s0 dt`` (sample ``s0``) with ``Q.shape[0] - 1`` steps of ``dt`` under
     a compiled control law (``law``, see ``law_torque``; ``CONSTANT`` applies ``tau_cmd``);
     writes the samples ``Q, V``, the accelerations ``A`` and the applied torques ``T``.
     Returns ``(status, sample)`` of the first failing evaluation (``(OK, -1)`` on success)."""
@@ -190,7 +190,7 @@ def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau
     V[0, :] = v0
     n = Q.shape[0] - 1
     for s in range(n + 1):
-        q, v, t = Q[s], V[s], t0 + s * dt
+        q, v, t = Q[s], V[s], (s0 + s) * dt
         th[:] = 0.0
         st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, cmd)
         if st == OK:

@@ -239,8 +239,8 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
     Q[0], V[0] = q0, v0
     for a in range(0, n, piece):
         b = min(n, a + piece)
-        status, s = K.run(*plant.args, c, law, gains, breaks, coefs, zero, method, Q[a].copy(), V[a].copy(), t[a],
-                          dt, Q[a:b + 1], V[a:b + 1], A[a:b + 1], T[a:b + 1])
+        status, s = K.run(*plant.args, c, law, gains, breaks, coefs, zero, method, Q[a].copy(), V[a].copy(), a, dt,
+                          Q[a:b + 1], V[a:b + 1], A[a:b + 1], T[a:b + 1])
         if status != OK:
             _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
         bar.update(b)
