@@ -179,8 +179,9 @@ def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
 
 
 def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -> dict:
-    """Stick-figure animation (GIF, matplotlib's PillowWriter) of the motion ``q`` (N, nq)
-    at times ``t`` (N,), played in real time at ``fps`` frames per second.
+    """Stick-figure animation (GIF written by Pillow, matplotlib's image library) of the
+    motion ``q`` (N, nq) at times ``t`` (N,), played in real time at ``fps`` frames per
+    second. The axes are drawn once and the robot over them in each frame (blitting).
 
     ``planar``: draw in 2-D (None: when every point stays in a world coordinate plane).
     Returns ``{"t", "points", "segments", "axes"}``: the frame times (F,), the drawn points
@@ -212,38 +213,54 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
     if path is None:
         return data
 
-    from matplotlib.animation import FuncAnimation, PillowWriter
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+    from PIL import Image
 
-    fig = Figure(figsize=(5, 5), layout="constrained")
+    fig = Figure(figsize=(5, 5))
     FigureCanvasAgg(fig)
     lo, hi = drawn.reshape(-1, drawn.shape[-1]).min(0), drawn.reshape(-1, drawn.shape[-1]).max(0)
     mid, half = (lo + hi) / 2, max((hi - lo).max() / 2 * 1.1, 0.1)
     if planar:
+        fig.subplots_adjust(left=0.16, bottom=0.11, right=0.96, top=0.92)
         ax = fig.add_subplot()
         ax.set_aspect("equal")
-        ax.set_xlim(mid[0] - half, mid[0] + half)
-        ax.set_ylim(mid[1] - half, mid[1] + half)
     else:
         ax = fig.add_subplot(projection="3d")
-        ax.set_xlim(mid[0] - half, mid[0] + half)
-        ax.set_ylim(mid[1] - half, mid[1] + half)
         ax.set_zlim(mid[2] - half, mid[2] + half)
         ax.set_zlabel(names[keep[2]])
+    ax.set_xlim(mid[0] - half, mid[0] + half)
+    ax.set_ylim(mid[1] - half, mid[1] + half)
     ax.set_xlabel(names[keep[0]])
     ax.set_ylabel(names[keep[1]])
-    lines = [ax.plot(*([0.0, 0.0],) * drawn.shape[-1], "o-", color="C0", lw=3, ms=4)[0] for _ in segments]
-    title = ax.set_title("")
+    # every segment in one line, separated by NaN: one artist to draw per frame
+    order = np.array([[i, j, i] for i, j in segments], dtype=int).reshape(-1)
+    gap = np.zeros(order.shape[0], dtype=bool)
+    gap[2::3] = True
 
-    def draw(f):
-        for line, (i, j) in zip(lines, segments):
-            seg = drawn[f, [i, j]]
-            line.set_data(seg[:, 0], seg[:, 1])
-            if not planar:
-                line.set_3d_properties(seg[:, 2])
+    def polyline(f):
+        xyz = drawn[f, order].copy()
+        xyz[gap] = np.nan
+        return xyz
+
+    line, = ax.plot(*polyline(0).T, "o-", color="C0", lw=3, ms=4, animated=True)
+    title = ax.set_title("", animated=True)
+    # the axes do not change: draw them once, then only the robot and the time (blitting)
+    canvas = fig.canvas
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    frames = []
+    for f in range(drawn.shape[0]):
+        canvas.restore_region(background)
+        xyz = polyline(f)
+        line.set_data(xyz[:, 0], xyz[:, 1])
+        if not planar:
+            line.set_3d_properties(xyz[:, 2])
         title.set_text(f"{model.name}  t = {data['t'][f]:.2f} s")
-        return lines
-
-    FuncAnimation(fig, draw, frames=drawn.shape[0], blit=False).save(path, writer=PillowWriter(fps=fps))
+        ax.draw_artist(line)
+        ax.draw_artist(title)
+        w, h = canvas.get_width_height()
+        frames.append(Image.frombuffer("RGBA", (w, h), bytes(canvas.buffer_rgba()), "raw", "RGBA", 0, 1).convert(
+            "RGB").quantize(colors=64))
+    frames[0].save(path, save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0)
     return data
