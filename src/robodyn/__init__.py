@@ -19,13 +19,16 @@ _LAZY = {
     "coriolis_matrix": "coriolis", "crba": "crba", "kinetic_energy": "energy", "potential_energy": "energy",
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
-    "nonlinear_effects": "terms",
+    "nonlinear_effects": "terms", "integrate": "integrate", "difference": "integrate",
     "hybrid_dynamics": "hybrid", "inverse_mass_matrix": "minv", "constrained_dynamics": "constrained",
     "ConstrainedDynamics": "constrained", "PointConstraint": "constrained", "WeldConstraint": "constrained",
     "LoopConstraint": "constrained", "DistanceConstraint": "constrained", "CouplingConstraint": "constrained",
     "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
 }
+# Applications, also imported on first use: name -> module.
+_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
+              "plots": None}
 
 
 def __getattr__(name):
@@ -33,6 +36,13 @@ def __getattr__(name):
         import importlib
 
         value = getattr(importlib.import_module(f".algorithms.{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in _LAZY_APPS:
+        import importlib
+
+        module = importlib.import_module(f".{_LAZY_APPS[name] or name}", __name__)
+        value = module if _LAZY_APPS[name] is None else getattr(module, name)
         globals()[name] = value
         return value
     if name == "warmup":
@@ -43,7 +53,7 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY) | {"warmup"})
+    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_APPS) | {"warmup"})
 
 
 __version__ = "0.1.0"
@@ -56,4 +66,5 @@ __all__ = [
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",
     "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
+    "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
 ]

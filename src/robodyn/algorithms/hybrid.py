@@ -28,7 +28,7 @@ from numba import prange
 
 from .._jit import core, inline, kernel, parallel
 from .. import joints as J
-from ..joints import friction_torque
+from ..joint_kernels import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul, matvec6,
                        motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
