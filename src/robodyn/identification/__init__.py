@@ -22,12 +22,13 @@ regressors themselves are :func:`robodyn.regressor` and the energy regressors.
 from .base import BaseParameters, base_parameters, parameter_names
 from .data import Log, preprocess, read_log, write_log
 from .estimation import Estimate, ols, physical, wls
-from .excitation import FourierTrajectory, condition_number, limits_of, optimize_excitation, write_excitation
+from .excitation import (FourierTrajectory, condition_number, feasible_trajectory, limits_of, optimize_excitation,
+                         write_excitation)
 from .identify import Identification, identify
 from .report import write_report
 
 __all__ = [
     "BaseParameters", "base_parameters", "parameter_names", "Log", "preprocess", "read_log", "write_log",
-    "Estimate", "ols", "physical", "wls", "FourierTrajectory", "condition_number", "limits_of",
+    "Estimate", "ols", "physical", "wls", "FourierTrajectory", "condition_number", "feasible_trajectory", "limits_of",
     "optimize_excitation", "write_excitation", "Identification", "identify", "write_report",
 ]

@@ -32,6 +32,7 @@ import numpy as np
 from ..algorithms.regressor import EXTRA_COLUMNS, extra_columns, regressor
 from ..joints import FREE
 from ..random import random_configuration
+from ._blas import one_blas_thread
 
 PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
 
@@ -119,6 +120,22 @@ def _combination_name(head: str, coeffs: np.ndarray, columns) -> str:
     return " ".join(parts)
 
 
+def _independent_in_order(Ws, candidates, rtol: float) -> list:
+    """Columns of ``Ws`` (unit norm) kept in order when farther than ``rtol`` from the span of
+    those kept before (Gram-Schmidt, orthogonalised twice)."""
+    basis = np.zeros((Ws.shape[0], 0))
+    kept = []
+    for j in candidates:
+        w = Ws[:, j]
+        for _ in range(2):
+            w = w - basis @ (basis.T @ w)
+        d = np.linalg.norm(w)
+        if d > rtol:
+            kept.append(int(j))
+            basis = np.column_stack([basis, w / d])
+    return kept
+
+
 def base_parameters(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
                     offset: bool = False, n_states: int | None = None, rtol: float = 1e-8,
                     seed: int = 0) -> BaseParameters:
@@ -151,18 +168,11 @@ def base_parameters(model, *, viscous: bool = False, coulomb: bool = False, arma
     nonzero = norms > rtol * scale
     Ws = np.zeros_like(W)
     Ws[:, nonzero] = W[:, nonzero] / norms[nonzero]
-    sv = np.linalg.svd(Ws, compute_uv=False)
+    with one_blas_thread():
+        sv = np.linalg.svd(Ws, compute_uv=False)
     rank = int(np.sum(sv > rtol * sv[0])) if sv.size else 0
-    basis = np.zeros((W.shape[0], 0))
-    kept = []
-    for j in np.flatnonzero(nonzero):
-        w = Ws[:, j]
-        for _ in range(2):
-            w = w - basis @ (basis.T @ w)
-        d = np.linalg.norm(w)
-        if d > rtol:
-            kept.append(j)
-            basis = np.column_stack([basis, w / d])
+    with one_blas_thread():
+        kept = _independent_in_order(Ws, np.flatnonzero(nonzero), rtol)
     if len(kept) != rank:
         raise ValueError(
             f"base_parameters: {rank} singular values above rtol={rtol:g} but {len(kept)} independent columns "
@@ -173,7 +183,8 @@ def base_parameters(model, *, viscous: bool = False, coulomb: bool = False, arma
     K = np.zeros((len(kept), p))
     K[np.arange(len(kept)), ind] = 1.0
     if dep.size:
-        beta = np.linalg.lstsq(W[:, ind], W[:, dep], rcond=None)[0]
+        with one_blas_thread():
+            beta = np.linalg.lstsq(W[:, ind], W[:, dep], rcond=None)[0]
         beta[np.abs(beta) < 1e-10 * max(1.0, np.abs(beta).max())] = 0.0
         K[:, dep] = beta
     names = tuple(_combination_name(columns[j], np.where(np.isin(np.arange(p), dep), K[r], 0.0), columns)

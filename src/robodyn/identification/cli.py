@@ -38,7 +38,8 @@ def cmd_excite(args) -> int:
     return 0
 
 
-def cmd_identify(args) -> int:    from ..io.urdf_writer import write_urdf
+def cmd_identify(args) -> int:
+    from ..io.urdf_writer import write_urdf
     from .base import base_parameters
     from .data import preprocess, read_log
     from .identify import identify

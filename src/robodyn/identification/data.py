@@ -154,7 +154,8 @@ def preprocess(log: Log, *, cutoff: float | None = None, order: int = 4, decimat
 
     1. Zero-phase Butterworth low-pass of ``order`` at ``cutoff`` Hz on positions, given
        velocities and accelerations, and torques (``scipy.signal.filtfilt``, forward and
-       backward: no phase lag, so torques and states stay aligned).
+       backward: no phase lag, so torques and states stay aligned; odd extension of
+       ``3 rate / cutoff`` samples at the ends).
     2. Missing velocities and accelerations: central differences of the filtered positions
        (``numpy.gradient``, second order), then of the velocities.
     3. ``trim`` samples dropped at each end (filter and difference edge effects; default
@@ -177,10 +178,12 @@ def preprocess(log: Log, *, cutoff: float | None = None, order: int = 4, decimat
         raise ValueError("decimate > 1 needs a low-pass cutoff (anti-aliasing)")
     if cutoff is not None:
         b, a = butter(order, cutoff / (fs / 2))
-        padlen = 3 * max(len(a), len(b))
+        # odd extension over three periods of the cutoff: the edge transients die out in it
+        padlen = max(3 * max(len(a), len(b)), 3 * int(np.ceil(fs / cutoff)))
         if len(log) <= padlen:
-            raise ValueError(f"log of {len(log)} samples is too short for the filter (needs > {padlen})")
-        filt = lambda x: None if x is None else filtfilt(b, a, x, axis=0)  # noqa: E731
+            raise ValueError(f"log of {len(log)} samples is too short for the filter at {cutoff:g} Hz "
+                             f"(needs more than {padlen})")
+        filt = lambda x: None if x is None else filtfilt(b, a, x, axis=0, padlen=padlen)  # noqa: E731
     else:
         filt = lambda x: x  # noqa: E731
     q = filt(log.q)

@@ -6,16 +6,18 @@ joint torques, ``beta = K theta`` the base parameters, friction columns included
 * ``ols``: ordinary least squares ``beta = W^+ y``, with ``cov = s^2 (W^T W)^-1`` and
   ``s^2 = |y - W beta|^2 / (N - r)``;
 * ``wls``: weighted least squares with one standard deviation per joint estimated from the
-  OLS residuals of that joint (Gautier, "Dynamic identification of robots with power model",
+  residuals of that joint (OLS first, then reweighted) (Gautier, "Dynamic identification of robots with power model",
   ICRA 1997; Khalil and Dombre 2002, section 12.5), ``cov = (W^T S^-1 W)^-1``;
 * ``physical``: the standard parameters ``theta(x)`` of physically consistent bodies, with
   each body's 4 x 4 pseudo-inertia ``J = [[Sigma, h], [h^T, m]]`` (``Sigma = tr(I)/2 1 - I``)
   written as ``J = U U^T``, ``U`` upper triangular with exponentiated diagonal (the
   log-Cholesky parameterisation of Rucker and Wensing, "Smooth parameterization of rigid-body
   inertia", IEEE RA-L 7(2), 2022), so that ``m > 0`` and ``J`` is positive definite for every
-  ``x``; friction coefficients are bounded below by 0. ``scipy.optimize.least_squares`` solves
-  ``min |W K theta(x) - y|^2 + w |theta(x) - theta_prior|^2`` with a small weight ``w``
-  (it only fixes the unobservable directions, which do not change the torques).
+  ``x``; friction coefficients are bounded below by 0. ``scipy.optimize.least_squares``
+  solves ``min |W K theta(x) - y|^2 + w |P (theta(x) - theta_prior)|^2``, through the
+  triangular factor of ``[W y]`` (``r`` rows whatever the number of samples); ``P = 1 - K^+ K``
+  projects on the unobservable directions, so the prior (the nominal model) only fixes what
+  the torques cannot tell and does not bias the base parameters.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._blas import one_blas_thread
 from .base import BaseParameters
 from .data import Log
 
@@ -74,15 +77,23 @@ def ols(W, y, nv: int) -> Estimate:
     return Estimate("ols", beta, std, sigma)
 
 
-def wls(W, y, nv: int) -> Estimate:
-    """Weighted least squares, one weight ``1 / sigma_j`` per joint from the OLS residuals."""
-    first = ols(W, y, nv)
-    sigma = np.maximum(first.sigma, 1e-12 * max(float(np.abs(y).max()), 1e-300))
-    w = np.tile(1.0 / sigma, W.shape[0] // nv)
-    beta = np.linalg.lstsq(W * w[:, None], y * w, rcond=None)[0]
-    res = (y - W @ beta).reshape(-1, nv)
-    sigma = np.sqrt((res ** 2).sum(axis=0) / max(W.shape[0] // nv - W.shape[1] / nv, 1))
-    return Estimate("wls", beta, _cov_std(W, w ** 2), sigma)
+def wls(W, y, nv: int, iterations: int = 10) -> Estimate:
+    """Weighted least squares, one weight ``1 / sigma_j`` per joint, the ``sigma_j`` estimated
+    from the residuals: first of OLS, then of the weighted estimate again until they change
+    by less than 1 % (iteratively reweighted, ``iterations`` at most)."""
+    est = ols(W, y, nv)
+    floor = 1e-12 * max(float(np.abs(y).max()), 1e-300)
+    rows = W.shape[0] // nv
+    for _ in range(iterations):
+        sigma = np.maximum(est.sigma, floor)
+        w = np.tile(1.0 / sigma, rows)
+        beta = np.linalg.lstsq(W * w[:, None], y * w, rcond=None)[0]
+        res = (y - W @ beta).reshape(-1, nv)
+        new = np.sqrt((res ** 2).sum(axis=0) / max(rows - W.shape[1] / nv, 1))
+        est = Estimate("wls", beta, _cov_std(W, w ** 2), new)
+        if np.all(np.abs(new - sigma) <= 0.01 * sigma):
+            break
+    return est
 
 
 # -- physically consistent estimation ------------------------------------------------------
@@ -153,24 +164,44 @@ def theta_jacobian(x) -> np.ndarray:
 LOG_BOUND = 25.0
 
 
-def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 1e-6, start=None,
-             max_nfev: int = 100) -> Estimate:
+def nearest_consistent(theta, eps: float = 1e-6) -> np.ndarray:
+    """A physically consistent body near ``theta``: the pseudo-inertia's eigenvalues raised to at
+    least ``eps`` times the largest (and a positive mass)."""
+    lam, V = np.linalg.eigh(pseudo_inertia(theta))
+    floor = eps * max(lam[-1], 1e-9)
+    return parameters_of_pseudo_inertia((V * np.maximum(lam, floor)) @ V.T)
+
+
+def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 1e-8, start=None,
+             max_nfev: int = 200) -> Estimate:
     """Physically consistent least squares (module docstring).
 
     ``prior`` (p,): standard parameters ``[theta, extra]`` the unobservable directions are
-    drawn to (usually the nominal model); ``start``: initial standard parameters (default
-    ``prior``). Friction columns (viscous, Coulomb) and armature are bounded below by 0.
-    The Jacobian is analytic (block diagonal ``d theta / d x``, :func:`theta_jacobian`).
+    drawn to (usually the nominal model); ``start``: initial standard parameters (default: the
+    least-squares estimate completed towards the prior, each body moved to the nearest
+    consistent one). Friction columns (viscous, Coulomb) and armature are bounded below by 0.
+    The Jacobian is analytic (block diagonal ``d theta / d x``, :func:`theta_jacobian`);
+    ``scipy.optimize.least_squares`` (trust region reflective, for the bounds) evaluates the
+    residual at most ``max_nfev`` times.
     """
     from scipy.optimize import least_squares
 
     nb, p = model.nbodies, base.K.shape[1]
     prior = np.asarray(prior, dtype=float)
-    start = prior if start is None else np.asarray(start, dtype=float)
-    if prior.shape != (p,) or start.shape != (p,):
-        raise ValueError(f"prior and start: expected shape ({p},), got {prior.shape} and {start.shape}")
-    A = W @ base.K  # (N nv, p): the full regressor seen through the base parameters
+    if prior.shape != (p,):
+        raise ValueError(f"prior: expected shape ({p},), got {prior.shape}")
+    if start is None:
+        start = base.completion(np.linalg.lstsq(W, y, rcond=None)[0], prior)
+        start[:10 * nb] = np.concatenate([nearest_consistent(start[10 * i:10 * i + 10]) for i in range(nb)])
+    start = np.asarray(start, dtype=float)
+    if start.shape != (p,):
+        raise ValueError(f"start: expected shape ({p},), got {start.shape}")
+    # |W beta - y|^2 = |R beta - z|^2 + const with [W y] = Q [[R, z], [0, rho]]: r rows, not N nv
+    Rz = np.linalg.qr(np.column_stack([W, y]), mode="r")
+    r = base.count
+    A, z = Rz[:r, :r] @ base.K, Rz[:r, r]
     reg = np.sqrt(prior_weight) * max(float(np.linalg.norm(A, axis=0).mean()), 1e-12)
+    N = np.eye(p) - np.linalg.pinv(base.K) @ base.K  # projector on the unobservable directions
     x0 = np.concatenate([np.concatenate([log_cholesky(start[10 * i:10 * i + 10]) for i in range(nb)]),
                          start[10 * nb:]])
     lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
@@ -193,14 +224,16 @@ def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 
 
     def residual(x):
         th = theta_of(x)
-        return np.concatenate([A @ th - y, reg * (th - prior)])
+        return np.concatenate([A @ th - z, reg * (N @ (th - prior))])
 
     def jacobian(x):
         D = jac_theta(x)
-        return np.vstack([A @ D, reg * D])
+        return np.vstack([A @ D, reg * (N @ D)])
 
-    sol = least_squares(residual, x0, jac=jacobian, bounds=(lower, upper), method="trf", max_nfev=max_nfev)
-    theta = theta_of(sol.x)
+    with one_blas_thread():
+        x = least_squares(residual, x0, jac=jacobian, bounds=(lower, upper), method="trf", max_nfev=max_nfev,
+                          xtol=1e-15, ftol=1e-15, gtol=1e-15).x
+    theta = theta_of(x)
     beta = base.K @ theta
     res = (y - W @ beta).reshape(-1, model.nv)
     sigma = np.sqrt((res ** 2).sum(axis=0) / max(res.shape[0] - base.count / model.nv, 1))

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..joints import FREE
+from ._blas import one_blas_thread
 
 
 @dataclass(frozen=True)
@@ -108,14 +109,31 @@ def limits_of(model, acceleration=10.0, velocity=None, margin: float = 0.05, spa
     nv = model.nv
     lo, hi = model.lower.copy(), model.upper.copy()
     bounded = np.isfinite(lo) & np.isfinite(hi)
-    mid = np.where(bounded, 0.5 * (lo + hi), 0.0)
-    half = np.where(bounded, 0.5 * (hi - lo), span / 2) * (1.0 - 2.0 * margin)
+    lo, hi = np.where(bounded, lo, -span / 2), np.where(bounded, hi, span / 2)
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo) * (1.0 - 2.0 * margin)
     vel = np.broadcast_to(np.asarray(velocity if velocity is not None else model.velocity_limit, float), (nv,)).copy()
     vel[~np.isfinite(vel)] = 2.0
     acc = np.broadcast_to(np.asarray(acceleration, dtype=float), (nv,)).copy()
     if np.any(~(vel > 0)) or np.any(~(acc > 0)) or np.any(~np.isfinite(acc)):
         raise ValueError(f"velocity and acceleration limits must be positive and finite, got {vel}, {acc}")
     return Limits(mid - half, mid + half, vel, acc)
+
+
+def feasible_trajectory(model, *, period: float = 10.0, harmonics: int = 5, samples: int = 100,
+                        limits: Limits | None = None, seed: int = 0) -> FourierTrajectory:
+    """A random Fourier trajectory (standard normal coefficients, centred in the position
+    range) scaled into the limits at ``samples`` points per period: the optimisation's
+    starting point, or a validation motion."""
+    lim = limits if limits is not None else limits_of(model)
+    nv, L = model.nv, int(harmonics)
+    t = np.arange(samples) * (period / samples)
+    rng = np.random.default_rng(seed)
+    x = np.concatenate([0.5 * (lim.lower + lim.upper), rng.standard_normal(2 * nv * L)])
+    return _unpack(_into_limits(x, nv, L, period, t, lim), nv, L, period)
+
+
+def _pack(traj: FourierTrajectory) -> np.ndarray:
+    return np.concatenate([traj.q0, traj.a.ravel(), traj.b.ravel()])
 
 
 def _unpack(x, nv, L, period):
@@ -177,18 +195,17 @@ def optimize_excitation(model, base, *, period: float = 10.0, harmonics: int = 5
     if L < 1 or samples < 2 or period <= 0:
         raise ValueError(f"harmonics >= 1, samples >= 2 and period > 0 required, got {L}, {samples}, {period}")
     t = np.arange(samples) * (period / samples)
-    rng = np.random.default_rng(seed)
-    x0 = np.concatenate([0.5 * (lim.lower + lim.upper), rng.standard_normal(2 * nv * L)])
-    x0 = _into_limits(x0, nv, L, period, t, lim)
+    x0 = _pack(feasible_trajectory(model, period=period, harmonics=L, samples=samples, limits=lim, seed=seed))
     init = condition_number(model, base, _unpack(x0, nv, L, period), t)
 
     def objective(x):
         c = condition_number(model, base, _unpack(x, nv, L, period), t)
         return np.log(c) if np.isfinite(c) else 1e3
 
-    res = minimize(objective, x0, method="SLSQP",
-                   constraints=[{"type": "ineq", "fun": lambda x: _constraints(_unpack(x, nv, L, period), t, lim)}],
-                   options={"maxiter": maxiter, "ftol": 1e-6})
+    with one_blas_thread():
+        res = minimize(objective, x0, method="SLSQP",
+                       constraints=[{"type": "ineq", "fun": lambda x: _constraints(_unpack(x, nv, L, period), t, lim)}],
+                       options={"maxiter": maxiter, "ftol": 1e-6})
     x = res.x if np.all(_constraints(_unpack(res.x, nv, L, period), t, lim) >= -1e-9) else \
         _into_limits(res.x, nv, L, period, t, lim)
     traj = _unpack(x, nv, L, period)

@@ -15,6 +15,7 @@ import numpy as np
 
 from ..algorithms.regressor import extended_parameters
 from ..errors import ModelError, RobodynWarning
+from ._blas import one_blas_thread
 from .base import BaseParameters, base_parameters
 from .data import Log
 from .estimation import Estimate, ols, physical, stack, wls
@@ -112,7 +113,7 @@ def nominal_parameters(model, base: BaseParameters) -> np.ndarray:
 
 def identify(model, log: Log, *, method: str = "ols", viscous: bool = True, coulomb: bool = True,
              armature: bool = False, offset: bool = False, base: BaseParameters | None = None,
-             prior_weight: float = 1e-6) -> Identification:
+             prior_weight: float = 1e-8) -> Identification:
     """Identify the base parameters of ``model`` from a preprocessed log.
 
     Args:
@@ -129,12 +130,13 @@ def identify(model, log: Log, *, method: str = "ols", viscous: bool = True, coul
     if base is None:
         base = base_parameters(model, viscous=viscous, coulomb=coulomb, armature=armature, offset=offset)
     W, y = stack(model, base, log)
-    s = np.linalg.svd(W, compute_uv=False)
-    cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
-    if method == "ols":
-        est = ols(W, y, model.nv)
-    elif method == "wls":
-        est = wls(W, y, model.nv)
-    else:
-        est = physical(model, base, W, y, nominal_parameters(model, base), prior_weight=prior_weight)
+    with one_blas_thread():
+        s = np.linalg.svd(W, compute_uv=False)
+        cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+        if method == "ols":
+            est = ols(W, y, model.nv)
+        elif method == "wls":
+            est = wls(W, y, model.nv)
+        else:
+            est = physical(model, base, W, y, nominal_parameters(model, base), prior_weight=prior_weight)
     return Identification(model, base, est, cond, base.project(nominal_parameters(model, base)), len(log))
