@@ -119,11 +119,10 @@ def test_agrees_with_pinocchio(path, floating_base):
     for j in range(1, pm.njoints):
         assert_rel(model.inertia[j - 1], pm.inertias[j].toDynamicParameters(), 1e-12, "parameters")
     rng = rng_for(erd_id(path), floating_base, "regressor")
-    for _ in range(2):
-        q, v, a = rd.random.random_state(model, rng)
-        Y = rd.regressor(model, q, v, a)
-        assert_rel(Y, pin.computeJointTorqueRegressor(pm, data, pair.pin_q(q), v, a), 1e-9)
-        assert_rel(Y @ model.inertial_parameters(), rd.rnea(model, q, v, a, friction=False, armature=False), 1e-9)
+    q, v, a = rd.random.random_state(model, rng)
+    Y = rd.regressor(model, q, v, a)
+    assert_rel(Y, pin.computeJointTorqueRegressor(pm, data, pair.pin_q(q), v, a), 1e-9)
+    assert_rel(Y @ model.inertial_parameters(), rd.rnea(model, q, v, a, friction=False, armature=False), 1e-9)
 
 
 def test_batch():
