@@ -8,7 +8,7 @@
 """
 
 from .builder import ModelBuilder
-from .io import DHLink, dh_transform, from_dh, load_urdf
+from .io import DHLink, dh_transform, from_dh, load_urdf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
@@ -25,6 +25,7 @@ _LAZY = {
     "LoopConstraint": "constrained", "DistanceConstraint": "constrained", "CouplingConstraint": "constrained",
     "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
+    "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
@@ -67,4 +68,5 @@ __all__ = [
     "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
+    "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
 ]

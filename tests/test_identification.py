@@ -1,0 +1,327 @@
+"""Identification (robodyn.identification): base-parameter counts and identities, Fourier
+excitation, CSV logs and their errors, filtering and differentiation, OLS/WLS standard
+deviations, the log-Cholesky parameterisation, end to end on the Panda (noise-free recovery,
+noisy prediction on another trajectory, physically consistent export), and the CLI."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn import identification as ident
+from robodyn.cli import main
+from robodyn.identification.identify import METHODS
+from robodyn.identification.estimation import log_cholesky, theta_jacobian, theta_of_log_cholesky
+from robodyn.model import check_inertial_parameters
+from helpers import PLANAR_2R, assert_rel, planar_2r, random_model, random_models, rng_for
+
+
+# -- base parameters --------------------------------------------------------------------------
+def _horizontal_2r():
+    """The built-in planar 2R with gravity along its joint axes (the arm moves in a horizontal plane)."""
+    model = rd.models.load("planar_2r")
+    axis_world = rd.forward_kinematics(model, np.zeros(2))[0, :3, :3] @ model.joint_axis[0]
+    return model.replace(gravity=9.81 * axis_world)
+
+
+BASE_COUNTS = [
+    ("planar_2r", lambda: rd.models.load("planar_2r"), 6),
+    ("planar_2r horizontal", _horizontal_2r, 4),
+    ("scara", lambda: rd.models.load("scara"), 8),
+    ("puma560", lambda: rd.models.load("puma560"), 36),
+    ("ur5", lambda: rd.models.load("ur5"), 36),
+    ("panda", lambda: rd.models.load("panda"), 43),
+]
+
+
+@functools.lru_cache(maxsize=None)
+def panda_base():
+    return ident.base_parameters(rd.models.load("panda"), viscous=True, coulomb=True)
+
+
+@pytest.mark.parametrize("build, count", [(b, c) for _, b, c in BASE_COUNTS], ids=[n for n, _, _ in BASE_COUNTS])
+def test_base_parameter_counts(build, count):
+    """Known counts (Khalil and Dombre 2002, Gautier 1991; Gaz et al. 2019 for the Panda), a
+    clear singular-value gap, and friction columns adding 2 nv."""
+    model = build()
+    base = ident.base_parameters(model)
+    assert base.count == count
+    assert base.gap > 1e6
+    assert ident.base_parameters(model, viscous=True, coulomb=True).count == count + 2 * model.nv
+
+
+def test_counts_are_structural():
+    """Other (or zero) inertial parameters give the same base parameters and the same K: the
+    grouping depends on the kinematics only."""
+    model = rd.models.load("puma560")
+    base = ident.base_parameters(model)
+    rng = rng_for("structural")
+    for theta in (rng.uniform(0.5, 2.0, 10 * model.nbodies) * model.inertial_parameters(),
+                  np.zeros(10 * model.nbodies)):
+        other = ident.base_parameters(model.replace(inertia=theta.reshape(6, 10), physical="warn"))
+        assert np.array_equal(other.independent, base.independent)
+        assert_rel(other.K, base.K, 1e-9)
+
+
+def test_planar_2r_names():
+    """Horizontal 2R arm of helpers.planar_2r (l1 = 0.8) with gravity along the joint axes:
+    Izz1 absorbs m2 l1^2 (Spong et al. 2006, section 7.4; Khalil and Dombre 2002, section 12.4)."""
+    model = planar_2r(**PLANAR_2R).replace(gravity=(0.0, 0.0, -9.81))
+    base = ident.base_parameters(model)
+    assert base.names == ("Izz1 + 0.64*m2", "mx2", "my2", "Izz2")
+    vertical = ident.base_parameters(planar_2r(**PLANAR_2R))
+    assert vertical.names == ("mx1 + 0.8*m2", "my1", "Izz1 + 0.64*m2", "mx2", "my2", "Izz2")
+
+
+@random_models
+def test_base_regressor_reproduces_rnea(model):
+    """On new random states: Y = Y_base K, and Y_base (K theta) == rnea (fixed and floating base)."""
+    base = ident.base_parameters(model, viscous=True, coulomb=True)
+    q, v, a = ident.base.random_states(model, 3, rng_for(model.name, "base"))
+    Y = rd.regressor(model, q, v, a, viscous=True, coulomb=True)
+    assert_rel(base.regressor(model, q, v, a) @ base.K, Y, 1e-9)
+    theta = np.concatenate([model.inertial_parameters(), np.full(2 * model.nv, 0.3)])
+    expected = rd.rnea(model.replace(damping=np.full(model.nv, 0.3), coulomb=np.full(model.nv, 0.3)), q, v, a)
+    assert_rel(base.regressor(model, q, v, a) @ base.project(theta), expected, 1e-9)
+    completed = base.completion(base.project(theta), np.zeros(theta.shape))
+    assert_rel(base.project(completed), base.project(theta), 1e-9)
+
+
+def test_base_parameter_errors():
+    with pytest.raises(ValueError, match="rtol"):
+        ident.base_parameters(rd.models.load("pendulum"), rtol=2.0)
+
+
+# -- excitation -------------------------------------------------------------------------------
+def test_fourier_derivatives_and_period():
+    rng = rng_for("fourier")
+    traj = ident.FourierTrajectory(rng.standard_normal(3), rng.standard_normal((3, 4)), rng.standard_normal((3, 4)), 2.5)
+    t = np.linspace(0, 5, 7)
+    q, qd, qdd = traj(t)
+    h = 1e-5
+    assert_rel(qd, (traj(t + h)[0] - traj(t - h)[0]) / (2 * h), 1e-8)
+    assert_rel(qdd, (traj(t + h)[1] - traj(t - h)[1]) / (2 * h), 1e-8)
+    assert_rel(traj(t + 2.5)[0], q, 1e-12)
+
+
+@functools.lru_cache(maxsize=None)
+def panda_excitation(seed: int):
+    """A small optimisation (3 harmonics, 40 samples, 6 iterations) of the Panda's excitation."""
+    model = rd.models.load("panda")
+    return ident.optimize_excitation(model, panda_base(), period=8.0, harmonics=3, samples=40, maxiter=6, seed=seed)
+
+
+def test_excitation_respects_limits_and_improves(tmp_path):
+    model = rd.models.load("panda")
+    result = panda_excitation(0)
+    assert result.condition_number <= result.initial_condition_number
+    lim = ident.limits_of(model)
+    t = np.arange(40) * 8.0 / 40
+    q, qd, qdd = result.trajectory(t)
+    tol = 1e-6
+    assert np.all(q <= lim.upper + tol) and np.all(q >= lim.lower - tol)
+    assert np.all(np.abs(qd) <= lim.velocity * (1 + tol)) and np.all(np.abs(qdd) <= lim.acceleration * (1 + tol))
+    assert np.all(lim.lower >= model.lower) and np.all(lim.upper <= model.upper)
+    csv, png = ident.write_excitation(tmp_path / "traj.csv", model, result, duration=3.0, rate=50.0)
+    log = ident.read_log(csv, model, require_tau=False)
+    assert len(log) == 150
+    assert_rel(np.hstack([log.q, log.qd, log.qdd]), np.hstack(result.trajectory(log.t)), 0.0)
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+# -- data -------------------------------------------------------------------------------------
+def _write(path, header, rows):
+    path.write_text(",".join(header) + "\n" + "".join(",".join(map(str, r)) + "\n" for r in rows))
+    return path
+
+
+def _two_joint_columns(kinds=("q", "tau")):
+    return ["time"] + [f"{k}_{j}" for k in kinds for j in ("joint1", "joint2")]
+
+
+def test_log_errors(tmp_path):
+    model = rd.models.load("planar_2r")
+    good = [[0.01 * i, 0.1, 0.2, 1.0, 2.0] for i in range(5)]
+    with pytest.raises(ValueError, match=r"missing columns \['tau_joint2'\]"):
+        ident.read_log(_write(tmp_path / "a.csv", _two_joint_columns()[:-1], [r[:-1] for r in good]), model)
+    rows = [r[:] for r in good]
+    rows[1][2], rows[3][4] = "nan", ""
+    with pytest.raises(ValueError, match=r"2 rows with missing or non-finite values at lines \[3, 5\]"):
+        ident.read_log(_write(tmp_path / "b.csv", _two_joint_columns(), rows), model)
+    rows = [r[:] for r in good]
+    rows[3][0] = 0.01
+    with pytest.raises(ValueError, match=r"time not strictly increasing at line 5"):
+        ident.read_log(_write(tmp_path / "c.csv", _two_joint_columns(), rows), model)
+    rows = [r[:] for r in good]
+    rows[2][1] = "abc"
+    with pytest.raises(ValueError, match=r"line 4, column 'q_joint1': not a number"):
+        ident.read_log(_write(tmp_path / "d.csv", _two_joint_columns(), rows), model)
+    with pytest.raises(ValueError, match=r"qd given for some joints only; missing columns \['qd_joint2'\]"):
+        ident.read_log(_write(tmp_path / "e.csv", _two_joint_columns() + ["qd_joint1"], [r + [0] for r in good]), model)
+    t = np.array([0.0, 0.01, 0.02, 0.04, 0.05])
+    with pytest.raises(ValueError, match="not uniformly sampled"):
+        ident.preprocess(ident.Log(t, np.zeros((5, 2)), tau=np.zeros((5, 2))))
+
+
+def test_preprocess_filters_differentiates_decimates():
+    """A slow sine with noise: filtered positions, velocities and accelerations close to the
+    analytic ones; decimation keeps every k-th sample; cutoffs that alias are refused."""
+    fs, f0 = 500.0, 0.5
+    t = np.arange(5000) / fs
+    w = 2 * np.pi * f0
+    q = np.stack([np.sin(w * t), 0.5 * np.cos(w * t)], axis=1)
+    rng = rng_for("preprocess")
+    log = ident.Log(t, q + 1e-5 * rng.standard_normal(q.shape), tau=q.copy())
+    out = ident.preprocess(log, cutoff=5.0, decimate=4)
+    k = int(np.ceil(fs / 5.0))
+    assert_rel(out.t, t[k:len(t) - k:4], 0.0)
+    tt = out.t
+    for x, exact, tol in ((out.q, [np.sin(w * tt), 0.5 * np.cos(w * tt)], 1e-3),
+                          (out.qd, [w * np.cos(w * tt), -0.5 * w * np.sin(w * tt)], 5e-3),
+                          (out.qdd, [-w * w * np.sin(w * tt), -0.5 * w * w * np.cos(w * tt)], 2e-2)):
+        exact = np.stack(exact, 1)
+        assert np.abs(x - exact).max() < tol * np.abs(exact).max()
+    exact = ident.preprocess(ident.Log(t, q, tau=q))  # no filter: second-order differences
+    assert_rel(exact.qd, np.stack([w * np.cos(w * exact.t), -0.5 * w * np.sin(w * exact.t)], 1), 1e-4)
+    with pytest.raises(ValueError, match="alias"):
+        ident.preprocess(log, cutoff=100.0, decimate=4)
+    with pytest.raises(ValueError, match="Nyquist"):
+        ident.preprocess(log, cutoff=300.0)
+    with pytest.raises(ValueError, match="anti-aliasing"):
+        ident.preprocess(log, decimate=2)
+
+
+# -- estimation -------------------------------------------------------------------------------
+def test_ols_standard_deviations_match_monte_carlo():
+    """The reported standard deviations of OLS and WLS match the spread of the estimates over
+    200 noise draws (within 15 %), on the 2R arm (WLS: joint-dependent noise levels)."""
+    model = rd.models.load("planar_2r")
+    base = ident.base_parameters(model)
+    q, v, a = ident.base.random_states(model, 100, rng_for("mc-states"))
+    W = base.regressor(model, q, v, a).reshape(-1, base.count)
+    y0 = W @ base.project(model.inertial_parameters())
+    rng = rng_for("monte-carlo")
+    # OLS assumes one noise level for all joints, WLS one per joint
+    for method, sigma in ((ident.ols, np.full(200, 0.2)), (ident.wls, np.tile([0.05, 0.5], 100))):
+        draws, stds = [], []
+        for _ in range(200):
+            est = method(W, y0 + sigma * rng.standard_normal(y0.shape), model.nv)
+            draws.append(est.beta)
+            stds.append(est.std)
+        ratio = np.std(draws, axis=0) / np.mean(stds, axis=0)
+        assert np.all(np.abs(ratio - 1) < 0.15), (method.__name__, ratio)
+
+
+def test_log_cholesky():
+    """Round trip, analytic Jacobian, and every coordinate vector gives a consistent body."""
+    rng = rng_for("log-cholesky")
+    for _ in range(5):
+        theta = rd.random.random_inertia(rng)
+        x = log_cholesky(theta, eps=0.0)
+        assert_rel(theta_of_log_cholesky(x), theta, 1e-12)
+        h = 1e-6
+        fd = np.stack([(theta_of_log_cholesky(x + h * e) - theta_of_log_cholesky(x - h * e)) / (2 * h)
+                       for e in np.eye(10)], axis=1)
+        assert_rel(theta_jacobian(x), fd, 1e-8)
+        check_inertial_parameters(theta_of_log_cholesky(rng.standard_normal(10)), "random coordinates")
+
+
+def _panda_truth():
+    model = rd.models.load("panda")
+    return model.replace(damping=np.linspace(0.3, 0.6, 7), coulomb=np.linspace(0.5, 0.9, 7))
+
+
+def _panda_log(truth, seed, duration, rate, noise_q=0.0, noise_tau=0.0):
+    """Seed 0: the optimised excitation; other seeds: a random trajectory within the limits."""
+    traj = panda_excitation(0).trajectory if seed == 0 else \
+        ident.feasible_trajectory(truth, period=8.0, harmonics=3, samples=40, seed=seed)
+    t, q, qd, qdd = traj.sample(duration, rate)
+    tau = rd.rnea(truth, q, qd, qdd)
+    rng = rng_for("panda-noise", seed)
+    return ident.Log(t, q, qd, qdd, tau), ident.Log(t, q + noise_q * rng.standard_normal(q.shape),
+                                                    tau=tau + noise_tau * rng.standard_normal(tau.shape))
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_panda_noise_free_recovers_base_parameters(method):
+    """Exact states and torques along an optimised trajectory: least squares recover the base
+    parameters (inertial and friction) to 1e-6 relative, each one; the physically consistent
+    fit (an iterative solver) reproduces the torques to 1e-6 and the parameters to 1e-2."""
+    truth = _panda_truth()
+    exact, _ = _panda_log(truth, 0, 8.0, 100.0)
+    result = ident.identify(truth.replace(damping=np.zeros(7), coulomb=np.zeros(7),
+                                          inertia=truth.inertia * 1.1), exact, method=method, base=panda_base())
+    expected = panda_base().project(np.concatenate([truth.inertial_parameters(), truth.damping, truth.coulomb]))
+    scale = np.maximum(np.abs(expected), 1e-3 * np.abs(expected).max())
+    error = np.max(np.abs(result.estimate.beta - expected) / scale)
+    if method == "physical":
+        assert_rel(result.predict(exact), exact.tau, 1e-6)
+        assert error < 1e-2
+    else:
+        assert error < 1e-6
+
+
+@pytest.mark.parametrize("method", ["ols", "wls", "physical"])
+def test_panda_noisy_predicts_another_trajectory(method, tmp_path):
+    """Encoder noise 1e-4 rad and torque noise 0.2 N m, filtered at 4 Hz and differentiated:
+    the torques of a different trajectory (measured, with the same noise) are predicted with
+    an RMS error below twice the noise level on every joint. The physically consistent
+    estimate passes the inertia checks and its URDF loads with physical='error'."""
+    truth, sigma = _panda_truth(), 0.2
+    _, noisy = _panda_log(truth, 0, 16.0, 200.0, noise_q=1e-4, noise_tau=sigma)
+    log = ident.preprocess(noisy, cutoff=4.0, decimate=2)
+    result = ident.identify(rd.models.load("panda"), log, method=method, base=panda_base())
+    other, other_noisy = _panda_log(truth, 1, 8.0, 100.0, noise_tau=sigma)
+    pred = result.predict(other)
+    rms = np.sqrt(np.mean((pred - other_noisy.tau) ** 2, axis=0))
+    assert np.all(rms < 2 * sigma), rms
+    if method == "physical":
+        theta = result.estimate.theta
+        for i in range(7):
+            check_inertial_parameters(theta[10 * i:10 * i + 10], f"body {i}")
+        path = tmp_path / "identified.urdf"
+        rd.write_urdf(result.identified_model(), path)
+        back = rd.load_urdf(path)
+        assert_rel(rd.rnea(back, other.q, other.qd, other.qdd), pred, 1e-9)
+        paths = ident.write_report(result, log, tmp_path / "report", validation=other_noisy.__class__(
+            other.t, other.q, other.qd, other.qdd, other_noisy.tau))
+        assert {p.name for p in paths} == {"report.txt", "torques.png", "residuals.png", "singular_values.png"}
+        text = paths[0].read_text()
+        assert "condition number" in text and "validation data" in text and "Izz1 + Iyy2" in text
+
+
+def test_identify_errors():
+    model = rd.models.load("planar_2r")
+    log = ident.Log(np.arange(3.0), np.zeros((3, 2)), tau=np.zeros((3, 2)))
+    with pytest.raises(ValueError, match="method"):
+        ident.identify(model, log, method="magic")
+    with pytest.raises(ValueError, match="preprocess"):
+        ident.identify(model, log)
+
+
+# -- command line -----------------------------------------------------------------------------
+def test_cli_excite_and_identify(tmp_path, capsys):
+    """`robodyn excite` writes a CSV and a plot; torques computed along it feed `robodyn
+    identify`, whose URDF loads with the default checks and reproduces the torques."""
+    traj = tmp_path / "traj.csv"
+    assert main(["excite", "elbow_3r", "--duration", "6", "--out", str(traj), "--harmonics", "2",
+                 "--samples", "30", "--maxiter", "3", "--rate", "50"]) == 0
+    assert traj.with_suffix(".png").read_bytes()[:4] == b"\x89PNG"
+    model = rd.models.load("elbow_3r").replace(damping=np.full(3, 0.2), coulomb=np.full(3, 0.4))
+    log = ident.read_log(traj, model, require_tau=False)
+    data = ident.write_log(tmp_path / "data.csv", model, log.t, log.q, qd=log.qd, qdd=log.qdd,
+                           tau=rd.rnea(model, log.q, log.qd, log.qdd))
+    urdf, report = tmp_path / "identified.urdf", tmp_path / "report"
+    assert main(["identify", "elbow_3r", str(data), "--method", "physical", "--out", str(urdf),
+                 "--report", str(report)]) == 0
+    out = capsys.readouterr().out
+    assert "condition number of the base regressor" in out and f"wrote {urdf}" in out
+    back = rd.load_urdf(urdf)
+    assert_rel(rd.rnea(back, log.q, log.qd, log.qdd), rd.rnea(model, log.q, log.qd, log.qdd), 1e-6)
+    assert (report / "report.txt").is_file() and (report / "torques.png").is_file()
+    bad = ident.write_log(tmp_path / "bad.csv", model, log.t, log.q)
+    assert main(["identify", "elbow_3r", str(bad)]) == 2
+    assert "missing columns" in capsys.readouterr().err
