@@ -8,7 +8,7 @@
 """
 
 from .builder import ModelBuilder
-from .io import DHLink, dh_transform, from_dh, load_urdf
+from .io import DHLink, dh_transform, from_dh, load_urdf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
@@ -20,6 +20,7 @@ _LAZY = {
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
     "nonlinear_effects": "terms",
+    "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
 }
 
 
@@ -48,4 +49,5 @@ __all__ = [
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
+    "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
 ]

@@ -3,6 +3,8 @@
     robodyn info MODEL          joint table, masses and inertias of a built-in robot or URDF
     robodyn demo [MODEL]        inverse and forward dynamics and the mass matrix at a sample state
     robodyn bench [MODEL]       per-call timings (and the comparison with Pinocchio if installed)
+    robodyn excite MODEL ...    excitation trajectory for identification (robodyn.identification.cli)
+    robodyn identify MODEL CSV  identified parameters, URDF and report (robodyn.identification.cli)
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 """
@@ -156,6 +158,9 @@ def main(argv=None) -> int:
     p.add_argument("--batch", type=int, default=10000, help="batch size for the batched timings")
     p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
     p.set_defaults(func=cmd_bench)
+    from .identification.cli import add_commands
+
+    add_commands(sub, common)
 
     args = parser.parse_args(argv)
     try:

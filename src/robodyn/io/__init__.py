@@ -2,6 +2,7 @@
 
 from .dh import DHLink, dh_transform, from_dh
 from .urdf import load_urdf
+from .urdf_writer import write_urdf
 from ..errors import RobodynWarning
 
-__all__ = ["DHLink", "dh_transform", "from_dh", "load_urdf", "RobodynWarning"]
+__all__ = ["DHLink", "dh_transform", "from_dh", "load_urdf", "write_urdf", "RobodynWarning"]

@@ -1,0 +1,259 @@
+"""Regressors: joint forces and energies as linear functions of the inertial parameters.
+
+The equation of motion is linear in the inertial parameters ``theta`` (10 per body, about
+the body origin in the body frame, order ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz,
+Izz]``, as in ``Model.inertial_parameters()``):
+
+    tau = Y(q, v, a) theta                       (joint-torque regressor, nv x 10 nb)
+    T(q, v) = Y_T(q, v) theta,  U(q) = Y_U(q) theta    (energy regressors, 10 nb)
+
+Body ``i``'s spatial force ``f_i = I_i a_i + v_i x* I_i v_i`` (body frame, with the base
+accelerating at ``-g``) is ``A_i theta_i`` with the 6 x 10 body regressor ``A_i`` whose column
+``c`` is the force of the unit parameter vector ``e_c``. Dof ``k`` of body ``j`` carries the
+forces of every body ``i`` in its subtree, so
+
+    Y[k, 10 i : 10 i + 10] = S_k^T  jX*_i  A_i      (i in the subtree of j, zero otherwise)
+
+computed by carrying each ``A_i`` up the chain of its ancestors: O(n d) per state, d the depth
+of the tree. Reference: Atkeson, An and Hollerbach, "Estimation of inertial parameters of
+manipulator loads and links", IJRR 5(3), 1986; Khalil and Dombre, *Modeling, Identification
+and Control of Robots* (2002), section 12.3 (Newton-Euler form of the identification model).
+
+Optional columns of the joint-torque regressor, appended after the ``10 nb`` inertial columns
+in this order, ``nv`` columns each (column ``k`` of a block acts on dof ``k`` only):
+
+    viscous    v_k                 (parameter: ``model.damping[k]``)
+    coulomb    sgn(v_k)            (``model.coulomb[k]``; ``tanh(v_k / eps)`` when
+                                    ``model.coulomb_smoothing = eps > 0``, as in ``rnea``)
+    armature   a_k                 (``model.armature[k]``)
+    offset     1                   (a constant torque offset of the joint)
+
+so that ``Y @ concatenate([theta, damping, coulomb, armature]) == rnea(q, v, a)`` with
+friction and armature on (see :func:`extended_parameters`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from .._jit import core, inline, kernel, parallel
+from ..spatial import dot6, force_act, force_cross, inertia_mul
+from . import _inputs
+from ._inputs import NONFINITE, OK, finite
+from .kinematics import poses_checked
+from .rnea import motion_pass
+
+EXTRA_COLUMNS = ("viscous", "coulomb", "armature", "offset")
+
+
+@kernel
+def workspace(nb, nv):
+    """Placements, world poses, motion, the unit parameter vectors and a 10 x 6 block."""
+    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
+            np.empty((3, 3)), np.empty(3), np.empty((nb, 6)), np.empty((nb, 6)), np.empty(6), np.empty(6),
+            np.empty(6), np.eye(10), np.empty((10, 6)), np.zeros(nv), np.zeros(3))
+
+
+@inline
+def body_regressor(E, vel, acc, W, t1, t2):
+    """``W[c] = I(e_c) acc + vel x* I(e_c) vel``: the body force of each unit parameter (10, 6)."""
+    for c in range(10):
+        inertia_mul(E[c], acc, W[c])
+        inertia_mul(E[c], vel, t1)
+        force_cross(vel, t1, t2)
+        for r in range(6):
+            W[c, r] += t2[r]
+
+
+@core
+def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
+    """Joint-torque regressor of one state into ``Y`` (nv, 10 nb + extra columns); returns a
+    status (see ``_inputs``). Columns past ``10 nb`` are the extra blocks in the order of
+    ``EXTRA_COLUMNS`` whose flags ``params[4:8]`` are non-zero."""
+    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
+    nb, nv = ints.shape[0], dofs.shape[0]
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    if check and not finite(a):
+        return NONFINITE
+    motion_pass(ints, dofs, liR, lip, v, a, params, vel, acc, vJ, t1, t2)
+    for k in range(nv):
+        for c in range(Y.shape[1]):
+            Y[k, c] = 0.0
+    for i in range(nb):
+        body_regressor(E, vel[i], acc[i], W, t1, t2)
+        j = i
+        while j >= 0:  # W holds A_i expressed in body j's frame
+            for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+                for c in range(10):
+                    Y[k, 10 * i + c] = dot6(dofs[k, :6], W[c])
+            if ints[j, 0] >= 0:
+                for c in range(10):
+                    force_act(liR[j], lip[j], W[c], t1)
+                    for r in range(6):
+                        W[c, r] = t1[r]
+            j = ints[j, 0]
+    col, eps = 10 * nb, params[3]
+    for block in range(4):
+        if params[4 + block] == 0.0:
+            continue
+        for k in range(nv):
+            if block == 0:
+                Y[k, col + k] = v[k]
+            elif block == 1:
+                Y[k, col + k] = (np.tanh(v[k] / eps) if eps > 0.0 else
+                                 (1.0 if v[k] > 0.0 else (-1.0 if v[k] < 0.0 else 0.0)))
+            elif block == 2:
+                Y[k, col + k] = a[k]
+            else:
+                Y[k, col + k] = 1.0
+        col += nv
+    return OK
+
+
+@parallel
+def _regressor_batch(ints, body, dofs, params, Q, V, A, check, Y, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+
+
+@core
+def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
+    """``out[0]`` kinetic-energy regressor (when ``v`` has entries), ``out[1]`` potential.
+
+    ``T = sum_i 1/2 V_i . I(theta_i) V_i``; ``U = -g . sum_i (m_i p_i + R_i h_i)``.
+    """
+    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    if v.shape[0] > 0:
+        motion_pass(ints, dofs, liR, lip, v, zero_v, zero_g, vel, acc, vJ, t1, t2)
+    for i in range(ints.shape[0]):
+        for c in range(10):
+            if v.shape[0] > 0:
+                inertia_mul(E[c], vel[i], t1)
+                out[0, 10 * i + c] = 0.5 * dot6(vel[i], t1)
+            else:
+                out[0, 10 * i + c] = 0.0
+            out[1, 10 * i + c] = 0.0
+        out[1, 10 * i] = -(grav[0] * op[i, 0] + grav[1] * op[i, 1] + grav[2] * op[i, 2])
+        for c in range(3):  # -g . R h = -(R^T g) . h
+            out[1, 10 * i + 1 + c] = -(grav[0] * oR[i, 0, c] + grav[1] * oR[i, 1, c] + grav[2] * oR[i, 2, c])
+    return OK
+
+
+@parallel
+def _energy_regressor_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check,
+                                             OUT[s], ws)
+
+
+def extra_columns(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+                  offset: bool = False) -> list[str]:
+    """Names of the extra regressor columns, in order: ``"viscous[joint]"``, ... one per dof."""
+    names = dof_names(model)
+    flags = dict(viscous=viscous, coulomb=coulomb, armature=armature, offset=offset)
+    return [f"{kind}[{n}]" for kind in EXTRA_COLUMNS if flags[kind] for n in names]
+
+
+def dof_names(model) -> list[str]:
+    """One name per entry of ``v``: the joint name, or ``name[vx]`` ... for a free joint."""
+    from ..joints import NV
+
+    out = []
+    for i in range(model.nbodies):
+        if NV[model.joint_type[i]] == 1:
+            out.append(model.body_joint_names[i])
+        else:
+            out.extend(f"{model.body_joint_names[i]}[{c}]" for c in ("vx", "vy", "vz", "wx", "wy", "wz"))
+    return out
+
+
+def extended_parameters(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+                        offset=None) -> np.ndarray:
+    """The parameter vector that matches :func:`regressor` with the same switches:
+    ``[theta, damping, coulomb, armature, offset]`` (blocks present when switched on;
+    ``offset`` is an (nv,) array of joint torque offsets, or None for no offset columns)."""
+    parts = [model.inertial_parameters()]
+    for on, values in ((viscous, model.damping), (coulomb, model.coulomb), (armature, model.armature)):
+        if on:
+            parts.append(np.asarray(values, dtype=float))
+    if offset is not None:
+        off = np.asarray(offset, dtype=float)
+        if off.shape != (model.nv,):
+            raise ValueError(f"offset: expected shape ({model.nv},), got {off.shape}")
+        parts.append(off)
+    return np.concatenate(parts)
+
+
+def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+              offset: bool = False, check_finite: bool = True) -> np.ndarray:
+    """Joint-torque regressor ``Y`` with ``Y @ model.inertial_parameters() == rnea(model, q, v,
+    a, friction=False, armature=False)``.
+
+    ``tau = Y(q, v, a) theta``, ``theta`` the 10 inertial parameters per body about the body
+    origin in the body frame, ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``.
+
+    Args:
+        q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
+        viscous, coulomb, armature, offset: append ``nv`` columns each, in this order, for
+            viscous friction (``v_k``), Coulomb friction (``sgn v_k``, smoothed as in ``rnea``
+            when ``model.coulomb_smoothing > 0``), armature (``a_k``) and a constant joint
+            torque offset (``1``); see :func:`extended_parameters` and :func:`extra_columns`.
+        check_finite: reject NaN/Inf inputs.
+
+    Returns:
+        Y: (..., nv, 10 nbodies + extra columns). For a floating base the first six rows are
+        the base wrench ``[force, torque]`` in the base frame, as in ``rnea``.
+
+    Reference: Khalil and Dombre (2002), section 12.3; Atkeson, An and Hollerbach (1986).
+    """
+    batch, x = _inputs.states(model, q=q, v=v, a=a)
+    k = model._kernel
+    flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
+    params = np.concatenate([k["params"][True], flags])
+    ncol = 10 * model.nbodies + model.nv * int(sum(flags))
+    Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
+    B = Q.shape[0]
+    Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
+    _regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], params, Q, V, A, check_finite, Y, status,
+                     _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, "regressor")
+    return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
+
+
+def _energy(model, check_finite, what, **arrays):
+    batch, x = _inputs.states(model, **arrays)
+    k = model._kernel
+    Q = _inputs.as_batch(x["q"])
+    V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
+    B = Q.shape[0]
+    OUT, status = np.empty((B, 2, 10 * model.nbodies)), np.empty(B, dtype=np.int64)
+    _energy_regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite,
+                            OUT, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, what)
+    return OUT.reshape(batch + OUT.shape[1:])
+
+
+def kinetic_energy_regressor(model, q, v, *, check_finite: bool = True) -> np.ndarray:
+    """``Y_T`` (..., 10 nbodies) with ``Y_T @ model.inertial_parameters() ==
+    kinetic_energy(model, q, v)``: ``T = sum_i 1/2 V_i . I(theta_i) V_i`` (body twists
+    ``V_i`` in body frames; armature not included, as in ``kinetic_energy``)."""
+    return _energy(model, check_finite, "kinetic_energy_regressor", q=q, v=v)[..., 0, :]
+
+
+def potential_energy_regressor(model, q, *, check_finite: bool = True) -> np.ndarray:
+    """``Y_U`` (..., 10 nbodies) with ``Y_U @ model.inertial_parameters() ==
+    potential_energy(model, q)``: ``U = -g . sum_i (m_i p_i + R_i h_i)`` (world pose
+    ``(R_i, p_i)`` of body ``i``), so only the mass and first-moment columns are non-zero."""
+    return _energy(model, check_finite, "potential_energy_regressor", q=q)[..., 1, :]

@@ -1,0 +1,33 @@
+"""Identification of inertial parameters and joint friction.
+
+    import robodyn as rd
+    from robodyn import identification as ident
+
+    model = rd.models.load("panda")
+    base = ident.base_parameters(model, viscous=True, coulomb=True)       # 43 + 14 columns
+    exc = ident.optimize_excitation(model, base, period=10, harmonics=5)   # Fourier series
+    exc.trajectory.to_csv("traj.csv", model, duration=20, rate=200)
+    log = ident.preprocess(ident.read_log("data.csv", model), cutoff=10)  # filter, differentiate
+    result = ident.identify(model, log, method="physical", base=base)
+    rd.write_urdf(result.identified_model(), "identified.urdf")
+    ident.write_report(result, log, "report/")
+
+Modules: :mod:`.base` (base parameters, ``K``, names), :mod:`.excitation` (Fourier series
+and their optimisation), :mod:`.data` (CSV logs, filtering, differentiation, decimation),
+:mod:`.estimation` (OLS, WLS, physically consistent), :mod:`.identify` (the pipeline),
+:mod:`.report` (text and plots), :mod:`.cli` (the ``excite`` and ``identify`` commands). The
+regressors themselves are :func:`robodyn.regressor` and the energy regressors.
+"""
+
+from .base import BaseParameters, base_parameters, parameter_names
+from .data import Log, preprocess, read_log, write_log
+from .estimation import Estimate, ols, physical, wls
+from .excitation import FourierTrajectory, condition_number, limits_of, optimize_excitation, write_excitation
+from .identify import Identification, identify
+from .report import write_report
+
+__all__ = [
+    "BaseParameters", "base_parameters", "parameter_names", "Log", "preprocess", "read_log", "write_log",
+    "Estimate", "ols", "physical", "wls", "FourierTrajectory", "condition_number", "limits_of",
+    "optimize_excitation", "write_excitation", "Identification", "identify", "write_report",
+]

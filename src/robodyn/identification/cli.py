@@ -1,0 +1,87 @@
+"""The ``robodyn excite`` and ``robodyn identify`` commands.
+
+    robodyn excite MODEL --duration 10 --out traj.csv      optimised excitation: CSV + PNG plot
+    robodyn identify MODEL data.csv [--method ols|wls|physical] --out identified.urdf --report DIR
+
+The data CSV layout is described in :mod:`robodyn.identification.data`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def _model(args):
+    from ..cli import load_model
+
+    if args.model is None:
+        raise ValueError(f"robodyn {args.command}: give a MODEL (built-in name or URDF path)")
+    return load_model(args.model, args.floating_base, args.physical)
+
+
+def cmd_excite(args) -> int:
+    from .base import base_parameters
+    from .excitation import limits_of, optimize_excitation, write_excitation
+
+    model = _model(args)
+    base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction)
+    period = args.period if args.period is not None else args.duration
+    lim = limits_of(model, acceleration=args.acceleration)
+    print(f"{model.name}: {base.count} base parameters; optimising {args.harmonics} harmonics over "
+          f"{period:g} s ({args.maxiter} iterations at most)")
+    result = optimize_excitation(model, base, period=period, harmonics=args.harmonics, samples=args.samples,
+                                 limits=lim, maxiter=args.maxiter, seed=args.seed)
+    print(f"condition number of the base regressor: {result.initial_condition_number:.4g} (initial) -> "
+          f"{result.condition_number:.4g} after {result.iterations} iterations ({result.message})")
+    for path in write_excitation(args.out, model, result, args.duration, args.rate):
+        print(f"wrote {path}")
+    return 0
+
+
+def cmd_identify(args) -> int:    from ..io.urdf_writer import write_urdf
+    from .base import base_parameters
+    from .data import preprocess, read_log
+    from .identify import identify
+    from .report import write_report
+
+    model = _model(args)
+    log = preprocess(read_log(args.data, model), cutoff=args.cutoff, decimate=args.decimate)
+    base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction, offset=args.offset)
+    result = identify(model, log, method=args.method, base=base)
+    print(result.summary())
+    if args.out:
+        write_urdf(result.identified_model(), args.out)
+        print(f"wrote {args.out}")
+    if args.report:
+        for path in write_report(result, log, args.report):
+            print(f"wrote {path}")
+    return 0
+
+
+def add_commands(sub, common) -> None:
+    """Register ``excite`` and ``identify`` on the subparsers of ``robodyn``; ``common(p)``
+    adds the model argument and the loader options."""
+    p = sub.add_parser("excite", help="optimised excitation trajectory for identification (CSV + PNG)")
+    common(p)
+    p.add_argument("--duration", type=float, default=10.0, help="length of the CSV trajectory (s)")
+    p.add_argument("--out", type=Path, required=True, help="CSV file; the plot goes next to it (.png)")
+    p.add_argument("--period", type=float, default=None, help="period of the Fourier series (default: duration)")
+    p.add_argument("--harmonics", type=int, default=5)
+    p.add_argument("--samples", type=int, default=100, help="samples per period in the optimisation")
+    p.add_argument("--rate", type=float, default=100.0, help="sampling rate of the CSV (Hz)")
+    p.add_argument("--acceleration", type=float, default=10.0, help="acceleration limit (rad/s^2 or m/s^2)")
+    p.add_argument("--maxiter", type=int, default=100, help="SLSQP iterations")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--no-friction", action="store_true", help="no viscous/Coulomb friction columns")
+    p.set_defaults(func=cmd_excite)
+    p = sub.add_parser("identify", help="identify inertial parameters and friction from a CSV log")
+    common(p)
+    p.add_argument("data", type=Path, help="CSV log: time, q_<joint>, [qd_<joint>, qdd_<joint>,] tau_<joint>")
+    p.add_argument("--method", choices=("ols", "wls", "physical"), default="ols")
+    p.add_argument("--out", type=Path, help="identified model as URDF")
+    p.add_argument("--report", type=Path, help="directory for report.txt and plots")
+    p.add_argument("--cutoff", type=float, default=None, help="zero-phase low-pass cutoff (Hz); default none")
+    p.add_argument("--decimate", type=int, default=1, help="keep every N-th sample after filtering")
+    p.add_argument("--no-friction", action="store_true", help="do not identify viscous/Coulomb friction")
+    p.add_argument("--offset", action="store_true", help="identify constant joint torque offsets too")
+    p.set_defaults(func=cmd_identify)

@@ -1,0 +1,209 @@
+"""Estimation of the base parameters from measured torques.
+
+With the base regressor stacked over the samples, ``W beta = y + noise`` (``y`` the measured
+joint torques, ``beta = K theta`` the base parameters, friction columns included):
+
+* ``ols``: ordinary least squares ``beta = W^+ y``, with ``cov = s^2 (W^T W)^-1`` and
+  ``s^2 = |y - W beta|^2 / (N - r)``;
+* ``wls``: weighted least squares with one standard deviation per joint estimated from the
+  OLS residuals of that joint (Gautier, "Dynamic identification of robots with power model",
+  ICRA 1997; Khalil and Dombre 2002, section 12.5), ``cov = (W^T S^-1 W)^-1``;
+* ``physical``: the standard parameters ``theta(x)`` of physically consistent bodies, with
+  each body's 4 x 4 pseudo-inertia ``J = [[Sigma, h], [h^T, m]]`` (``Sigma = tr(I)/2 1 - I``)
+  written as ``J = U U^T``, ``U`` upper triangular with exponentiated diagonal (the
+  log-Cholesky parameterisation of Rucker and Wensing, "Smooth parameterization of rigid-body
+  inertia", IEEE RA-L 7(2), 2022), so that ``m > 0`` and ``J`` is positive definite for every
+  ``x``; friction coefficients are bounded below by 0. ``scipy.optimize.least_squares`` solves
+  ``min |W K theta(x) - y|^2 + w |theta(x) - theta_prior|^2`` with a small weight ``w``
+  (it only fixes the unobservable directions, which do not change the torques).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .base import BaseParameters
+from .data import Log
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """``beta`` (r,) base parameters and their standard deviations ``std`` (r,); ``theta``:
+    full standard parameters ``[inertial (10 nb), extra columns]`` (only for ``physical``,
+    else None); ``sigma`` (nv,) residual standard deviation per joint; ``method``."""
+
+    method: str
+    beta: np.ndarray
+    std: np.ndarray
+    sigma: np.ndarray
+    theta: np.ndarray | None = None
+
+    @property
+    def relative_std(self) -> np.ndarray:
+        """``std / |beta|`` in percent (inf where beta is 0)."""
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return 100.0 * self.std / np.abs(self.beta)
+
+
+def stack(model, base: BaseParameters, log: Log):
+    """``(W, y)``: the base regressor (N nv, r) and the torques (N nv,) of a log whose
+    ``qd``, ``qdd`` and ``tau`` are known (see ``data.preprocess``)."""
+    if log.qd is None or log.qdd is None or log.tau is None:
+        raise ValueError("the log needs velocities, accelerations and torques; run preprocess() first")
+    W = base.regressor(model, log.q, log.qd, log.qdd)
+    return W.reshape(-1, base.count), log.tau.reshape(-1)
+
+
+def _cov_std(W, weights_sq, s2=1.0):
+    A = W.T @ (W * weights_sq[:, None])
+    return np.sqrt(np.maximum(np.diag(np.linalg.pinv(A)) * s2, 0.0))
+
+
+def ols(W, y, nv: int) -> Estimate:
+    """Ordinary least squares (module docstring)."""
+    n, r = W.shape
+    if n <= r:
+        raise ValueError(f"ols: {n} equations for {r} base parameters; record a longer log")
+    beta = np.linalg.lstsq(W, y, rcond=None)[0]
+    res = y - W @ beta
+    s2 = float(res @ res) / (n - r)
+    std = _cov_std(W, np.ones(n), s2)
+    sigma = np.sqrt((res.reshape(-1, nv) ** 2).sum(axis=0) / max(n // nv - r / nv, 1))
+    return Estimate("ols", beta, std, sigma)
+
+
+def wls(W, y, nv: int) -> Estimate:
+    """Weighted least squares, one weight ``1 / sigma_j`` per joint from the OLS residuals."""
+    first = ols(W, y, nv)
+    sigma = np.maximum(first.sigma, 1e-12 * max(float(np.abs(y).max()), 1e-300))
+    w = np.tile(1.0 / sigma, W.shape[0] // nv)
+    beta = np.linalg.lstsq(W * w[:, None], y * w, rcond=None)[0]
+    res = (y - W @ beta).reshape(-1, nv)
+    sigma = np.sqrt((res ** 2).sum(axis=0) / max(W.shape[0] // nv - W.shape[1] / nv, 1))
+    return Estimate("wls", beta, _cov_std(W, w ** 2), sigma)
+
+
+# -- physically consistent estimation ------------------------------------------------------
+def pseudo_inertia(theta) -> np.ndarray:
+    """4 x 4 pseudo-inertia ``[[tr(I)/2 1 - I, h], [h^T, m]]`` of 10 parameters."""
+    m, h = theta[0], theta[1:4]
+    I = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
+    J = np.empty((4, 4))
+    J[:3, :3] = 0.5 * np.trace(I) * np.eye(3) - I
+    J[:3, 3] = J[3, :3] = h
+    J[3, 3] = m
+    return J
+
+
+def parameters_of_pseudo_inertia(J) -> np.ndarray:
+    """10 parameters of a pseudo-inertia: ``I = tr(Sigma) 1 - Sigma``."""
+    S = J[:3, :3]
+    I = np.trace(S) * np.eye(3) - S
+    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], I[0, 0], I[0, 1], I[1, 1], I[0, 2], I[1, 2], I[2, 2]])
+
+
+def log_cholesky(theta, eps: float = 1e-9) -> np.ndarray:
+    """``[alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3]`` with ``J = U U^T``,
+    ``U = e^alpha [[e^d1, s12, s13, t1], [0, e^d2, s23, t2], [0, 0, e^d3, t3], [0, 0, 0, 1]]``.
+    A semi-definite ``J`` (point mass, zero mass) is regularised by ``eps`` times its scale."""
+    J = pseudo_inertia(theta)
+    J = J + eps * max(np.abs(J).max(), 1e-6) * np.eye(4)
+    P = np.eye(4)[::-1]
+    U = P @ np.linalg.cholesky(P @ J @ P) @ P  # upper triangular, U U^T = J
+    e = U[3, 3]
+    V = U / e
+    return np.array([np.log(e), np.log(V[0, 0]), np.log(V[1, 1]), np.log(V[2, 2]), V[0, 1], V[1, 2], V[0, 2],
+                     V[0, 3], V[1, 3], V[2, 3]])
+
+
+def _upper_factor(x) -> np.ndarray:
+    alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3 = x
+    return np.exp(alpha) * np.array([[np.exp(d1), s12, s13, t1], [0.0, np.exp(d2), s23, t2],
+                                     [0.0, 0.0, np.exp(d3), t3], [0.0, 0.0, 0.0, 1.0]])
+
+
+# entry of U that each coordinate after alpha scales (d1, d2, d3 exponentiated, the rest linear)
+_ENTRIES = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))
+
+
+def theta_of_log_cholesky(x) -> np.ndarray:
+    """10 inertial parameters of the log-Cholesky coordinates (see :func:`log_cholesky`)."""
+    U = _upper_factor(x)
+    return parameters_of_pseudo_inertia(U @ U.T)
+
+
+def theta_jacobian(x) -> np.ndarray:
+    """``d theta / d x`` (10, 10) of :func:`theta_of_log_cholesky`: ``dJ = dU U^T + U dU^T``."""
+    U = _upper_factor(x)
+    out = np.empty((10, 10))
+    dU = U.copy()  # d U / d alpha = U
+    for k in range(10):
+        if k > 0:
+            dU = np.zeros((4, 4))
+            r, c = _ENTRIES[k - 1]
+            dU[r, c] = U[r, c] if k <= 3 else np.exp(x[0])
+        dJ = dU @ U.T
+        out[:, k] = parameters_of_pseudo_inertia(dJ + dJ.T)
+    return out
+
+
+# log-Cholesky coordinates kept within +-LOG_BOUND: masses and inertias within e^(+-2 LOG_BOUND)
+LOG_BOUND = 25.0
+
+
+def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 1e-6, start=None,
+             max_nfev: int = 100) -> Estimate:
+    """Physically consistent least squares (module docstring).
+
+    ``prior`` (p,): standard parameters ``[theta, extra]`` the unobservable directions are
+    drawn to (usually the nominal model); ``start``: initial standard parameters (default
+    ``prior``). Friction columns (viscous, Coulomb) and armature are bounded below by 0.
+    The Jacobian is analytic (block diagonal ``d theta / d x``, :func:`theta_jacobian`).
+    """
+    from scipy.optimize import least_squares
+
+    nb, p = model.nbodies, base.K.shape[1]
+    prior = np.asarray(prior, dtype=float)
+    start = prior if start is None else np.asarray(start, dtype=float)
+    if prior.shape != (p,) or start.shape != (p,):
+        raise ValueError(f"prior and start: expected shape ({p},), got {prior.shape} and {start.shape}")
+    A = W @ base.K  # (N nv, p): the full regressor seen through the base parameters
+    reg = np.sqrt(prior_weight) * max(float(np.linalg.norm(A, axis=0).mean()), 1e-12)
+    x0 = np.concatenate([np.concatenate([log_cholesky(start[10 * i:10 * i + 10]) for i in range(nb)]),
+                         start[10 * nb:]])
+    lower, upper = np.full(p, -np.inf), np.full(p, np.inf)
+    logs = [10 * i + k for i in range(nb) for k in range(4)]
+    lower[logs], upper[logs] = -LOG_BOUND, LOG_BOUND
+    nonneg = [10 * nb + k for k, name in enumerate(base.columns[10 * nb:])
+              if name.split("[")[0] in ("viscous", "coulomb", "armature")]
+    lower[nonneg] = 0.0
+    x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
+
+    def theta_of(x):
+        return np.concatenate([np.concatenate([theta_of_log_cholesky(x[10 * i:10 * i + 10]) for i in range(nb)]),
+                               x[10 * nb:]])
+
+    def jac_theta(x):
+        D = np.eye(p)
+        for i in range(nb):
+            D[10 * i:10 * i + 10, 10 * i:10 * i + 10] = theta_jacobian(x[10 * i:10 * i + 10])
+        return D
+
+    def residual(x):
+        th = theta_of(x)
+        return np.concatenate([A @ th - y, reg * (th - prior)])
+
+    def jacobian(x):
+        D = jac_theta(x)
+        return np.vstack([A @ D, reg * D])
+
+    sol = least_squares(residual, x0, jac=jacobian, bounds=(lower, upper), method="trf", max_nfev=max_nfev)
+    theta = theta_of(sol.x)
+    beta = base.K @ theta
+    res = (y - W @ beta).reshape(-1, model.nv)
+    sigma = np.sqrt((res ** 2).sum(axis=0) / max(res.shape[0] - base.count / model.nv, 1))
+    s2 = float((res ** 2).sum()) / max(W.shape[0] - base.count, 1)
+    std = _cov_std(W, np.ones(W.shape[0]), s2)  # linearised: the least-squares covariance at the solution
+    return Estimate("physical", beta, std, sigma, theta)

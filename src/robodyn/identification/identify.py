@@ -1,0 +1,140 @@
+"""The identification pipeline: base parameters, estimation, prediction, identified model.
+
+    base = base_parameters(model, viscous=True, coulomb=True)
+    result = identify(model, preprocess(read_log("data.csv", model), cutoff=10), method="wls")
+    result.predict(other_log)          # torques of another motion
+    result.identified_model()          # a Model with the estimated parameters
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..algorithms.regressor import extended_parameters
+from ..errors import ModelError, RobodynWarning
+from .base import BaseParameters, base_parameters
+from .data import Log
+from .estimation import Estimate, ols, physical, stack, wls
+
+METHODS = ("ols", "wls", "physical")
+
+
+@dataclass(frozen=True)
+class Identification:
+    """Result of :func:`identify`: the nominal ``model``, its ``base`` parameters, the
+    ``estimate``, the ``condition_number`` of the stacked base regressor, and the nominal
+    base parameters ``beta_nominal`` (K times the model's own parameters, offsets 0)."""
+
+    model: object
+    base: BaseParameters
+    estimate: Estimate
+    condition_number: float
+    beta_nominal: np.ndarray
+    samples: int
+
+    def predict(self, log: Log) -> np.ndarray:
+        """Joint torques (N, nv) of the identified model along a log's motion."""
+        if log.qd is None or log.qdd is None:
+            raise ValueError("predict: the log needs velocities and accelerations; run preprocess() first")
+        return self.base.regressor(self.model, log.q, log.qd, log.qdd) @ self.estimate.beta
+
+    def standard_parameters(self) -> np.ndarray:
+        """Full parameters ``[theta, extra]``: the physically consistent estimate, or for
+        least squares the parameters closest to the nominal ones with the estimated base
+        parameters (same torques for every motion)."""
+        if self.estimate.theta is not None:
+            return self.estimate.theta
+        return self.base.completion(self.estimate.beta, self.prior())
+
+    def prior(self) -> np.ndarray:
+        return nominal_parameters(self.model, self.base)
+
+    def extra(self) -> dict:
+        """Identified per-dof extra parameters by kind (``viscous``, ``coulomb``, ...)."""
+        theta = self.standard_parameters()
+        out, col, nv = {}, 10 * self.model.nbodies, self.model.nv
+        for kind in ("viscous", "coulomb", "armature", "offset"):
+            if self.base.extra[kind]:
+                out[kind] = theta[col:col + nv]
+                col += nv
+        return out
+
+    def identified_model(self):
+        """The model with the identified inertial parameters, viscous and Coulomb friction and
+        armature (offsets have no place in a model: see :meth:`extra`).
+
+        Least-squares estimates that are not physically consistent give a model built with
+        ``physical="warn"`` (and a :class:`RobodynWarning`); negative friction is set to 0
+        with a warning. A negative mass raises :class:`ModelError`: use ``method="physical"``.
+        """
+        theta = self.standard_parameters()
+        nb = self.model.nbodies
+        changes = {"inertia": theta[:10 * nb].reshape(nb, 10)}
+        fields = {"viscous": "damping", "coulomb": "coulomb", "armature": "armature"}
+        for kind, values in self.extra().items():
+            if kind in fields:
+                if np.any(values < 0):
+                    warnings.warn(f"identified {kind} friction/armature negative at dofs "
+                                  f"{np.flatnonzero(values < 0).tolist()}: set to 0", RobodynWarning, stacklevel=2)
+                changes[fields[kind]] = np.maximum(values, 0.0)
+        try:
+            return self.model.replace(**changes, physical="error")
+        except ModelError as e:
+            if self.estimate.method == "physical":
+                raise
+            model = self.model.replace(**changes, physical="warn")
+            warnings.warn(f"the {self.estimate.method} estimate is not physically consistent ({e}); "
+                          "method='physical' gives a consistent one", RobodynWarning, stacklevel=2)
+            return model
+
+    def summary(self) -> str:
+        e = self.estimate
+        lines = [f"Identification of {self.model.name!r} by {e.method.upper()} from {self.samples} samples",
+                 f"condition number of the base regressor: {self.condition_number:.4g}",
+                 f"residual standard deviation per joint: {np.array2string(e.sigma, precision=4)}",
+                 "",
+                 f"{'#':>3} {'estimate':>13} {'std':>11} {'std %':>8} {'nominal':>13}  base parameter"]
+        for k, name in enumerate(self.base.names):
+            lines.append(f"{k + 1:>3} {e.beta[k]:13.6g} {e.std[k]:11.4g} {e.relative_std[k]:8.3g} "
+                         f"{self.beta_nominal[k]:13.6g}  {name}")
+        return "\n".join(lines)
+
+
+def nominal_parameters(model, base: BaseParameters) -> np.ndarray:
+    """The model's own ``[theta, extra]`` in the column order of ``base`` (offsets 0)."""
+    e = base.extra
+    return extended_parameters(model, viscous=e["viscous"], coulomb=e["coulomb"], armature=e["armature"],
+                               offset=np.zeros(model.nv) if e["offset"] else None)
+
+
+def identify(model, log: Log, *, method: str = "ols", viscous: bool = True, coulomb: bool = True,
+             armature: bool = False, offset: bool = False, base: BaseParameters | None = None,
+             prior_weight: float = 1e-6) -> Identification:
+    """Identify the base parameters of ``model`` from a preprocessed log.
+
+    Args:
+        log: samples with ``q``, ``qd``, ``qdd`` and ``tau`` (``data.preprocess`` fills the
+            derivatives).
+        method: ``"ols"``, ``"wls"`` or ``"physical"`` (see :mod:`.estimation`).
+        viscous, coulomb, armature, offset: the extra columns identified with the inertial
+            parameters (ignored when ``base`` is given: its own switches apply).
+        base: precomputed base parameters (default :func:`base_parameters` of the model).
+        prior_weight: weight of the nominal parameters in ``physical``.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
+    if base is None:
+        base = base_parameters(model, viscous=viscous, coulomb=coulomb, armature=armature, offset=offset)
+    W, y = stack(model, base, log)
+    s = np.linalg.svd(W, compute_uv=False)
+    cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
+    if method == "ols":
+        est = ols(W, y, model.nv)
+    elif method == "wls":
+        est = wls(W, y, model.nv)
+    else:
+        est = physical(model, base, W, y, nominal_parameters(model, base), prior_weight=prior_weight)
+    return Identification(model, base, est, cond, base.project(nominal_parameters(model, base)), len(log))

@@ -1,0 +1,140 @@
+"""URDF writer: ``write_urdf(model, path=None) -> str``, read back by ``load_urdf``.
+
+Each body becomes a link (its ``<inertial>`` at the centre of mass, axes of the body frame,
+mass-less bodies without ``<inertial>``) and each joint a revolute, continuous (a revolute
+joint without position limits), or prismatic joint with its placement (``rpy`` extrinsic
+X-Y-Z, ``R = Rz Ry Rx``), axis, ``<limit>`` and ``<dynamics damping friction>``. Frames (links
+merged into bodies) become mass-less links on fixed joints. A fixed base's root link keeps
+its name (the model's frame attached to the world); a floating base's root link is body 0,
+and the file must be loaded with ``floating_base=True``. Numbers are written with ``repr``
+(exact round trip).
+
+What URDF cannot hold is reported with a :class:`RobodynWarning`: armature, Coulomb
+smoothing, a gravity other than ``(0, 0, -9.81)`` (``load_urdf(gravity=...)`` sets it), and
+velocity/effort limits of a prismatic joint without position limits. A one-sided position
+limit raises ``ValueError``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from .. import joints as J
+from ..errors import RobodynWarning
+
+
+def _num(x) -> str:
+    return " ".join(repr(float(v)) for v in np.atleast_1d(x))
+
+
+def _origin(R, p) -> str:
+    from scipy.spatial.transform import Rotation
+
+    with warnings.catch_warnings():  # gimbal lock: scipy picks one of the equivalent angle sets
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(np.asarray(R)).as_euler("xyz")
+    return f'<origin xyz="{_num(p)}" rpy="{_num(rpy)}"/>'
+
+
+def _unique(name: str, taken: set) -> str:
+    out, k = name, 1
+    while out in taken:
+        out, k = f"{name}_{k}", k + 1
+    taken.add(out)
+    return out
+
+
+def _inertial(theta) -> list[str]:
+    m = float(theta[0])
+    if m <= 0.0:
+        return []
+    c = np.asarray(theta[1:4]) / m
+    Io = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
+    Ic = Io - m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+    return ["    <inertial>",
+            f'      <origin xyz="{_num(c)}" rpy="0.0 0.0 0.0"/>',
+            f'      <mass value="{_num(m)}"/>',
+            f'      <inertia ixx="{_num(Ic[0, 0])}" ixy="{_num(Ic[0, 1])}" ixz="{_num(Ic[0, 2])}" '
+            f'iyy="{_num(Ic[1, 1])}" iyz="{_num(Ic[1, 2])}" izz="{_num(Ic[2, 2])}"/>',
+            "    </inertial>"]
+
+
+def write_urdf(model, path=None) -> str:
+    """The URDF text of ``model`` (module docstring); also written to ``path`` if given."""
+    lost = []
+    if np.any(model.armature != 0):
+        lost.append("armature")
+    if model.coulomb_smoothing != 0:
+        lost.append("coulomb_smoothing")
+    if np.any(model.gravity != np.array([0.0, 0.0, -9.81])):
+        lost.append(f"gravity {model.gravity.tolist()} (pass it to load_urdf)")
+    taken = set(model.link_names) | set(model.frame_names)
+    lines = ["<?xml version=\"1.0\"?>", f"<robot name={quoteattr(model.name)}>"]
+    floating = model.floating_base
+    world = [k for k in range(len(model.frame_names)) if model.frame_body[k] == -1]
+    if floating:
+        root = model.link_names[0]
+    elif world and np.array_equal(model.frame_R[world[0]], np.eye(3)) and not np.any(model.frame_p[world[0]]):
+        root = model.frame_names[world[0]]  # the root link the model was loaded from
+    else:
+        root = _unique("world", taken)
+
+    def link_of(body: int) -> str:
+        return root if body < 0 else model.link_names[body]
+
+    lines.append(f"  <link name={quoteattr(root)}>")
+    lines += _inertial(model.inertia[0]) if floating else []
+    lines.append("  </link>")
+    joint_names = set(model.body_joint_names)
+    for i in range(model.nbodies):
+        jt = model.joint_type[i]
+        if jt == J.FREE:
+            continue
+        k = model.idx_v[i]
+        lo, hi = model.lower[k], model.upper[k]
+        bounded = np.isfinite(lo) and np.isfinite(hi)
+        if np.isfinite(lo) != np.isfinite(hi):
+            raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} has a one-sided position limit "
+                             f"[{lo}, {hi}], which URDF cannot express")
+        kind = ("revolute" if bounded else "continuous") if jt == J.REVOLUTE else "prismatic"
+        lines.append(f"  <link name={quoteattr(model.link_names[i])}>")
+        lines += _inertial(model.inertia[i])
+        lines.append("  </link>")
+        lines.append(f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"{kind}\">")
+        lines.append(f"    <parent link={quoteattr(link_of(model.parent[i]))}/>")
+        lines.append(f"    <child link={quoteattr(model.link_names[i])}/>")
+        lines.append(f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}")
+        lines.append(f'    <axis xyz="{_num(model.joint_axis[i])}"/>')
+        attrs = f'lower="{_num(lo)}" upper="{_num(hi)}" ' if bounded else ""
+        for key, val in (("velocity", model.velocity_limit[k]), ("effort", model.effort_limit[k])):
+            if np.isfinite(val):
+                attrs += f'{key}="{_num(val)}" '
+        if bounded or (kind == "continuous" and attrs):
+            lines.append(f"    <limit {attrs.strip()}/>")
+        elif attrs:
+            lost.append(f"velocity/effort limits of the unbounded prismatic joint {model.body_joint_names[i]!r}")
+        if model.damping[k] or model.coulomb[k]:
+            lines.append(f'    <dynamics damping="{_num(model.damping[k])}" friction="{_num(model.coulomb[k])}"/>')
+        lines.append("  </joint>")
+    for f in range(len(model.frame_names)):
+        name, body = model.frame_names[f], int(model.frame_body[f])
+        if name == root:
+            continue
+        jname = _unique(f"{name}_fixed", joint_names)
+        lines += [f"  <link name={quoteattr(name)}/>",
+                  f"  <joint name={quoteattr(jname)} type=\"fixed\">",
+                  f"    <parent link={quoteattr(link_of(body))}/>",
+                  f"    <child link={quoteattr(name)}/>",
+                  f"    {_origin(model.frame_R[f], model.frame_p[f])}",
+                  "  </joint>"]
+    lines.append("</robot>")
+    text = "\n".join(lines) + "\n"
+    if lost:
+        warnings.warn(f"write_urdf: URDF cannot hold {', '.join(lost)}; not written", RobodynWarning, stacklevel=2)
+    if path is not None:
+        Path(path).write_text(text)
+    return text
