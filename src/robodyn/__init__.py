@@ -19,9 +19,12 @@ _LAZY = {
     "coriolis_matrix": "coriolis", "crba": "crba", "kinetic_energy": "energy", "potential_energy": "energy",
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
-    "nonlinear_effects": "terms",
+    "nonlinear_effects": "terms", "integrate": "integrate", "difference": "integrate",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
 }
+# Applications, also imported on first use: name -> module.
+_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
+              "plots": None}
 
 
 def __getattr__(name):
@@ -29,6 +32,13 @@ def __getattr__(name):
         import importlib
 
         value = getattr(importlib.import_module(f".algorithms.{_LAZY[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    if name in _LAZY_APPS:
+        import importlib
+
+        module = importlib.import_module(f".{_LAZY_APPS[name] or name}", __name__)
+        value = module if _LAZY_APPS[name] is None else getattr(module, name)
         globals()[name] = value
         return value
     if name == "warmup":
@@ -39,7 +49,7 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY) | {"warmup"})
+    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_APPS) | {"warmup"})
 
 
 __version__ = "0.1.0"
@@ -50,4 +60,5 @@ __all__ = [
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
+    "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
 ]

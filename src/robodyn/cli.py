@@ -5,6 +5,8 @@
     robodyn bench [MODEL]       per-call timings (and the comparison with Pinocchio if installed)
     robodyn excite MODEL ...    excitation trajectory for identification (robodyn.identification.cli)
     robodyn identify MODEL CSV  identified parameters, URDF and report (robodyn.identification.cli)
+    robodyn simulate MODEL      simulation, free or controlled (plots, GIF, CSV; see cli_simulation)
+    robodyn torques MODEL CSV   joint forces of a trajectory: inertial, Coriolis, gravity
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 """
@@ -158,9 +160,11 @@ def main(argv=None) -> int:
     p.add_argument("--batch", type=int, default=10000, help="batch size for the batched timings")
     p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
     p.set_defaults(func=cmd_bench)
-    from .identification.cli import add_commands
+    from .identification.cli import add_commands as add_identification_commands
+    from .cli_simulation import add_commands as add_simulation_commands
 
-    add_commands(sub, common)
+    add_identification_commands(sub, common)
+    add_simulation_commands(sub, common)
 
     args = parser.parse_args(argv)
     try:

@@ -1,0 +1,179 @@
+"""Motion on the configuration manifold: ``q ⊕ v`` and its inverse ``q1 ⊖ q0``.
+
+Configurations of 1-dof joints add: ``q_i + v_i``. A free joint's configuration is a pose
+``(p, R)`` (``q = [p, quaternion (x, y, z, w)]``) and its velocity a twist ``[v_lin, omega]``
+in the child (base) frame; it moves by the exponential map of SE(3), as Pinocchio does::
+
+    integrate:   (p, R) ⊕ xi = (p, R) exp(xi),      exp(xi) = (V(omega) v_lin, exp3(omega))
+    difference:  q1 ⊖ q0 = log((p0, R0)^-1 (p1, R1))
+
+with ``V(w) = I + (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2``, ``t = |w|``. So
+``integrate(q, v * dt)`` follows the motion of constant body twist ``v`` for a time ``dt``
+exactly, and ``difference(q0, integrate(q0, d)) == d`` (rotations below pi).
+
+Reference: Lynch and Park, *Modern Robotics* (2017), sections 3.2.3 and 3.3.3 (exponential
+coordinates of SO(3) and SE(3)); Pinocchio's ``integrate`` / ``difference``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import joints as J
+from . import _inputs
+
+# Below this angle the series expansions of the exponential's coefficients are used.
+_SMALL = 1e-4
+
+
+def _skew(w: np.ndarray) -> np.ndarray:
+    """``[w]x`` (..., 3, 3)."""
+    z = np.zeros(w.shape[:-1])
+    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
+                     np.stack([w[..., 2], z, -w[..., 0]], -1),
+                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
+
+
+def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Hamilton product of quaternions ``(x, y, z, w)`` (..., 4)."""
+    av, aw, bv, bw = a[..., :3], a[..., 3:], b[..., :3], b[..., 3:]
+    return np.concatenate([aw * bv + bw * av + np.cross(av, bv), aw * bw - np.sum(av * bv, -1, keepdims=True)], -1)
+
+
+def _quat_matrix(quat: np.ndarray) -> np.ndarray:
+    x, y, z, w = np.moveaxis(quat / np.linalg.norm(quat, axis=-1, keepdims=True), -1, 0)
+    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
+
+
+def _coefficients(t: np.ndarray):
+    """``(1 - cos t) / t^2`` and ``(t - sin t) / t^3`` (series below ``_SMALL``)."""
+    small = t < _SMALL
+    ts = np.where(small, 1.0, t)
+    a = np.where(small, 0.5 - t * t / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
+    b = np.where(small, 1.0 / 6.0 - t * t / 120.0, (ts - np.sin(ts)) / ts ** 3)
+    return a, b
+
+
+def exp_se3(xi: np.ndarray):
+    """Quaternion (..., 4) and translation (..., 3) of ``exp(xi)``, ``xi = [v_lin, omega]``."""
+    v, w = xi[..., :3], xi[..., 3:]
+    t = np.linalg.norm(w, axis=-1)
+    half = 0.5 * t
+    small = t < _SMALL
+    sinc_half = np.where(small, 0.5 - t * t / 48.0, np.sin(half) / np.where(small, 1.0, t))
+    quat = np.concatenate([sinc_half[..., None] * w, np.cos(half)[..., None]], -1)
+    a, b = _coefficients(t)
+    wx = np.cross(w, v)
+    p = v + a[..., None] * wx + b[..., None] * np.cross(w, wx)
+    return quat, p
+
+
+def log_se3(quat: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``[v_lin, omega]`` (..., 6) with ``exp_se3`` giving the pose ``(quat, p)``, ``|omega| <= pi``."""
+    quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+    quat = np.where(quat[..., 3:] < 0, -quat, quat)  # the shorter rotation
+    s = np.linalg.norm(quat[..., :3], axis=-1)
+    t = 2.0 * np.arctan2(s, quat[..., 3])
+    small = t < _SMALL
+    w = quat[..., :3] * np.where(small, 2.0 + t * t / 12.0, t / np.where(small, 1.0, s))[..., None]
+    # V(w)^-1 = I - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2
+    ts = np.where(small, 1.0, t)
+    c = np.where(small, 1.0 / 12.0 + t * t / 720.0, (1.0 - ts * np.sin(ts) / (2.0 * (1.0 - np.cos(ts)))) / ts ** 2)
+    wp = np.cross(w, p)
+    v = p - 0.5 * wp + c[..., None] * np.cross(w, wp)
+    return np.concatenate([v, w], -1)
+
+
+def _free_blocks(model):
+    for i in np.flatnonzero(model.joint_type == J.FREE):
+        yield int(model.idx_q[i]), int(model.idx_v[i])
+
+
+def _scalar_indices(model):
+    one = model.joint_type != J.FREE
+    return model.idx_q[one], model.idx_v[one]
+
+
+def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
+    """The configuration reached from ``q`` by the velocity increment ``v`` (e.g. ``v dt``).
+
+    ``q ⊕ v``: 1-dof joints ``q_i + v_i``; a free joint ``(p, R) exp([v_lin, omega])`` with
+    the twist in the base frame (see the module docstring).
+
+    Args:
+        q: (..., nq) configuration (unit quaternions for free joints). v: (..., nv).
+
+    Returns:
+        (..., nq), unit quaternions of the sign nearer ``q``'s (``q_quat . out_quat >= 0``). Equals Pinocchio's ``integrate(model, q, v)``;
+        ``difference(model, q, integrate(model, q, v)) == v`` for rotations below pi.
+    Reference: Lynch and Park, *Modern Robotics*, eq. (3.88).
+    """
+    batch, x = _inputs.states(model, q=q, v=v)
+    q, v = x["q"], x["v"]
+    _check(model, check_finite, "integrate", q=q, v=v)
+    out = q.copy()
+    iq, iv = _scalar_indices(model)
+    out[..., iq] += v[..., iv]
+    for kq, kv in _free_blocks(model):
+        quat0 = q[..., kq + 3:kq + 7] / np.linalg.norm(q[..., kq + 3:kq + 7], axis=-1, keepdims=True)
+        dquat, dp = exp_se3(v[..., kv:kv + 6])
+        out[..., kq:kq + 3] = q[..., kq:kq + 3] + np.einsum("...ij,...j->...i", _quat_matrix(quat0), dp)
+        quat = _quat_mul(quat0, dquat)
+        quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
+        out[..., kq + 3:kq + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+    return _inputs.unflatten(out, batch)
+
+
+def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
+    """The velocity increment ``d`` (..., nv) with ``integrate(model, q0, d) == q1``.
+
+    ``q1 ⊖ q0``: 1-dof joints ``q1_i - q0_i``; a free joint ``log((p0, R0)^-1 (p1, R1))``
+    in the frame of ``q0``'s base, rotation part of norm at most pi. Equals Pinocchio's
+    ``difference(model, q0, q1)``. Reference: Lynch and Park, *Modern Robotics*, sec. 3.3.3.
+    """
+    q0, q1 = (_as_configuration(model, name, a) for name, a in (("q0", q0), ("q1", q1)))
+    try:
+        q0, q1 = np.broadcast_arrays(q0, q1)
+    except ValueError:
+        raise ValueError(f"difference: shapes of q0 {q0.shape} and q1 {q1.shape} do not broadcast") from None
+    _check(model, check_finite, "difference", q0=q0, q1=q1)
+    lead = q0.shape[:-1]
+    d = np.zeros(lead + (model.nv,))
+    iq, iv = _scalar_indices(model)
+    d[..., iv] = q1[..., iq] - q0[..., iq]
+    for kq, kv in _free_blocks(model):
+        quat0, quat1 = q0[..., kq + 3:kq + 7], q1[..., kq + 3:kq + 7]
+        quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
+        conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
+        dp = np.einsum("...ji,...j->...i", _quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
+        d[..., kv:kv + 6] = log_se3(_quat_mul(conj0, quat1), dp)
+    return d
+
+
+def _as_configuration(model, name: str, a) -> np.ndarray:
+    try:
+        a = np.asarray(a, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected an array of numbers, got {type(a).__name__}") from None
+    if a.ndim == 0 or a.shape[-1] != model.nq:
+        raise ValueError(f"{name}: expected shape (..., {model.nq}), got {a.shape}")
+    return a
+
+
+def _check(model, check_finite: bool, what: str, **arrays) -> None:
+    """NaN/Inf and the unit norm of the free joints' quaternions."""
+    if check_finite:
+        for name, a in arrays.items():
+            if not np.all(np.isfinite(a)):
+                idx = tuple(np.argwhere(~np.isfinite(a))[0].tolist())
+                raise ValueError(f"{what}: {name} contains NaN or Inf (first at index {idx})")
+    for name, a in arrays.items():
+        if a.shape[-1] != model.nq:
+            continue
+        for kq, _ in _free_blocks(model):
+            n = np.linalg.norm(a[..., kq + 3:kq + 7], axis=-1)
+            if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
+                raise ValueError(f"{what}: {name}: quaternion q[{kq + 3}:{kq + 7}] has norm "
+                                 f"{float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))]):.6g}, not 1; normalise it")

@@ -1,0 +1,147 @@
+"""The ``simulate`` and ``torques`` commands of the ``robodyn`` command line.
+
+    robodyn simulate MODEL [--controller none|pd-gravity|computed-torque] [--duration 5] [--dt 0.001]
+                     [--integrator rk4] [--plot out.png] [--gif out.gif] [--csv out.csv]
+    robodyn torques MODEL traj.csv [--plot contributions.png]
+
+``simulate`` starts at rest at ``--q0`` (default: every joint at 0, or mid-range when 0 is
+outside its limits) and drives the robot to ``--target`` (default: ``q0 + 0.5`` rad or m per
+joint, kept inside the limits): ``pd-gravity`` regulates to the target, ``computed-torque``
+tracks a quintic from ``q0`` to the target in the first half of the run. The gains follow
+from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
+so that light wrist joints do not make the closed loop too stiff for the fixed step). ``--csv`` writes
+the trajectory in the format of :mod:`robodyn.simulation.trajectory`, which ``torques``
+reads (or any CSV with a ``t`` column and ``q:<joint>`` columns) to plot the joint forces
+split into inertial, Coriolis/centrifugal and gravity parts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+CONTROLLERS = ("none", "pd-gravity", "computed-torque")
+
+
+def _vector(text: str | None, n: int, name: str):
+    if text is None:
+        return None
+    try:
+        x = np.array([float(s) for s in text.split(",")])
+    except ValueError:
+        raise ValueError(f"{name}: expected {n} comma-separated numbers, got {text!r}") from None
+    if x.shape != (n,):
+        raise ValueError(f"{name}: expected {n} comma-separated numbers, got {x.shape[0]}")
+    return x
+
+
+def start_and_target(model, q0=None, target=None):
+    """Default start (0, or mid-range outside the limits) and target (``q0 + 0.5`` inside the
+    limits) of the 1-dof joints; a floating base starts at the origin, upright."""
+    from .joints import FREE
+
+    if q0 is None:
+        q0 = np.zeros(model.nq)
+        for i in range(model.nbodies):
+            k, kv = model.idx_q[i], model.idx_v[i]
+            if model.joint_type[i] == FREE:
+                q0[k + 6] = 1.0
+            elif not model.lower[kv] <= 0.0 <= model.upper[kv]:
+                q0[k] = 0.5 * (model.lower[kv] + model.upper[kv])
+    if target is None and model.nq == model.nv:
+        margin = 0.05 * np.where(np.isfinite(model.upper - model.lower), model.upper - model.lower, 0.0)
+        lo, hi = model.lower + margin, model.upper - margin
+        target = np.clip(q0 + 0.5, lo, hi)
+    return q0, target
+
+
+def cmd_simulate(args) -> int:
+    from . import control
+    from .plots import animate, plot_simulation
+    from .simulation import simulate
+
+    from .cli import load_model
+
+    model = load_model(args.model, args.floating_base, args.physical)
+    q0, target = start_and_target(model, _vector(args.q0, model.nq, "--q0"), _vector(args.target, model.nv, "--target"))
+    w = args.omega
+    if not (np.isfinite(w) and w > 0):
+        raise ValueError(f"--omega: must be finite and > 0, got {w}")
+    if args.controller == "none":
+        controller = None
+    elif args.controller == "pd-gravity":
+        from .algorithms.crba import crba
+
+        m = np.diag(crba(model, q0)) if model.nq == model.nv else np.ones(model.nv)
+        controller = control.PDGravity(model, target, w * w * m, 2.0 * w * m)
+    else:
+        if model.nq != model.nv:
+            raise ValueError("--controller computed-torque needs a fixed-base model")
+        reference = control.quintic(q0, target, args.duration / 2)
+        controller = control.ComputedTorque(model, reference, w * w, 2.0 * w)
+    traj = simulate(model, q0, np.zeros(model.nv), args.duration, args.dt, controller, args.integrator)
+    drift = np.abs(traj.energy - traj.energy[0]).max()
+    print(f"robodyn simulate {model.name!r}: {traj.t.shape[0] - 1} steps of {args.dt:g} s ({args.integrator}), "
+          f"controller {args.controller}")
+    print(f"  energy: start {traj.energy[0]:.6g} J, end {traj.energy[-1]:.6g} J, max |E - E0| {drift:.3g} J")
+    if traj.tracking_error is not None:
+        print(f"  tracking error: max {np.abs(traj.tracking_error).max():.3g}, final {np.abs(traj.tracking_error[-1]).max():.3g}")
+    if traj.lyapunov is not None:
+        print(f"  Lyapunov function: start {traj.lyapunov[0]:.6g}, end {traj.lyapunov[-1]:.6g}, "
+              f"largest increase over a step {max(np.diff(traj.lyapunov).max(), 0.0):.3g}")
+    print(f"  applied torques: max |tau| {np.abs(traj.tau).max():.4g}")
+    if args.csv:
+        traj.to_csv(args.csv)
+        print(f"  wrote {args.csv}")
+    if args.plot:
+        plot_simulation(traj, args.plot)
+        print(f"  wrote {args.plot}")
+    if args.gif:
+        animate(model, traj.t, traj.q, args.gif, fps=args.fps)
+        print(f"  wrote {args.gif}")
+    return 0
+
+
+def cmd_torques(args) -> int:
+    from .plots import plot_torques
+    from .simulation.trajectory import coordinate_names, read_csv
+
+    from .cli import load_model
+
+    model = load_model(args.model, args.floating_base, args.physical)
+    t, q, v, a = read_csv(model, args.trajectory)
+    data = plot_torques(model, t, q, v, a, args.plot)
+    print(f"robodyn torques {model.name!r}: {t.shape[0]} samples from {args.trajectory}")
+    print(f"  {'joint':<24} {'max|inertial|':>14} {'max|coriolis|':>14} {'max|gravity|':>14} {'max|total|':>14}")
+    for k, name in enumerate(coordinate_names(model)[1]):
+        vals = [np.abs(data[key][:, k]).max() for key in ("inertial", "coriolis", "gravity", "total")]
+        print(f"  {name:<24} " + " ".join(f"{x:14.4g}" for x in vals))
+    if args.plot:
+        print(f"  wrote {args.plot}")
+    return 0
+
+
+def add_commands(sub, common) -> None:
+    """Register ``simulate`` and ``torques`` on the ``robodyn`` subcommand parser."""
+    from .simulation import INTEGRATORS, SCIPY_INTEGRATORS
+
+    p = sub.add_parser("simulate", help="simulate the robot, free or under a controller; plots, GIF, CSV")
+    common(p)
+    p.add_argument("--controller", choices=CONTROLLERS, default="none")
+    p.add_argument("--duration", type=float, default=5.0, help="seconds (default 5)")
+    p.add_argument("--dt", type=float, default=1e-3, help="sample time and fixed step, seconds (default 0.001)")
+    p.add_argument("--integrator", choices=INTEGRATORS + SCIPY_INTEGRATORS, default="rk4")
+    p.add_argument("--q0", help="initial configuration, comma-separated (default: see the module doc)")
+    p.add_argument("--target", help="target joint positions, comma-separated (default q0 + 0.5)")
+    p.add_argument("--omega", type=float, default=10.0,
+                   help="closed-loop natural frequency w, rad/s (default 10), critically damped: computed torque "
+                        "Kp = w^2, Kd = 2 w; pd-gravity Kp = w^2 m_jj, Kd = 2 w m_jj with m_jj = diag M(q0)")
+    p.add_argument("--plot", help="PNG: joints, tracking errors, torques, energy and Lyapunov function")
+    p.add_argument("--gif", help="GIF animation of the robot as a stick figure")
+    p.add_argument("--fps", type=int, default=20, help="frames per second of the GIF (default 20)")
+    p.add_argument("--csv", help="write the trajectory (t, q, v, a, tau, energy, ...) as CSV")
+    p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("torques", help="joint forces of a trajectory split into inertial, Coriolis, gravity")
+    common(p)
+    p.add_argument("trajectory", help="CSV file with a 't' column and 'q:<joint>' columns (e.g. simulate --csv)")
+    p.add_argument("--plot", help="PNG of the contributions per joint")
+    p.set_defaults(func=cmd_torques)

@@ -1,0 +1,14 @@
+"""Model-based control: controllers ``(t, q, v) -> tau`` and joint-space references.
+
+    import robodyn as rd
+    from robodyn import control
+    ref = control.quintic(q0, q1, duration=2.0)
+    ctrl = control.ComputedTorque(model, ref, kp=100.0, kd=20.0)
+    traj = rd.simulate(model, q0, v0, 3.0, 1e-3, controller=ctrl)
+"""
+
+from .controllers import ComputedTorque, Controller, PDGravity, PIDGravity, SlotineLi, TaskSpacePD
+from .references import PointToPoint, Sampled, cubic, quintic
+
+__all__ = ["Controller", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
+           "cubic", "quintic"]

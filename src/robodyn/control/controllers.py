@@ -1,0 +1,289 @@
+"""Model-based joint controllers: callables ``(t, q, v) -> tau`` for :func:`robodyn.simulate`.
+
+Every controller holds its own model (the plant may be another one: model mismatch) and
+exposes ``lyapunov(t, q, v)`` when the theory gives a Lyapunov function of the closed loop
+with an exact model, and ``desired(t) -> (q_d, qd_d, qdd_d)`` when it tracks a reference.
+Errors are ``e = q_d - q``, ``ed = qd_d - qd`` (except Slotine-Li, written as in its paper
+with ``q~ = q - q_d``). Gains are scalars or (nv,) vectors (diagonal gain matrices), > 0.
+
+=================== ======================================================== ===================================
+controller          law                                                      Lyapunov function
+=================== ======================================================== ===================================
+PDGravity           ``Kp e - Kd qd + g(q)``                                  ``qd^T M qd / 2 + e^T Kp e / 2``
+PIDGravity          ``Kp e + Ki int(e) - Kd qd + g(q)``                      (none reported)
+ComputedTorque      ``M (qdd_d + Kd ed + Kp e) + C qd + g (+ friction)``     ``ed^T ed / 2 + e^T Kp e / 2``
+TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``           ``qd^T M qd / 2 + ex^T Kp ex / 2``
+SlotineLi           ``M qdd_r + C qd_r + g (+ friction) - Kd s``             ``s^T M s / 2 + q~^T Lambda Kd q~``
+=================== ======================================================== ===================================
+
+References: Spong, Hutchinson, Vidyasagar, *Robot Modeling and Control* (2006), chapter 8
+(PD with gravity compensation, inverse dynamics control, passivity-based control);
+Takegaki and Arimoto (1981); Slotine and Li, "On the adaptive control of robot
+manipulators", IJRR 6(3), 1987; Siciliano et al., *Robotics* (2009), section 8.6 (task-space PD).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..algorithms.coriolis import coriolis_matrix
+from ..algorithms.crba import crba
+from ..algorithms._inputs import raise_for_status
+from . import _kernels
+from .references import PointToPoint, Sampled
+from ..algorithms.rnea import rnea
+from ..algorithms.terms import gravity
+
+
+def gain(name: str, value, n: int) -> np.ndarray:
+    """A diagonal gain as an (n,) vector of positive numbers (from a scalar or a vector)."""
+    try:
+        g = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a positive number or shape ({n},), got {np.shape(value)}") from None
+    if not np.all(np.isfinite(g)) or np.any(g <= 0):
+        raise ValueError(f"{name}: gains must be finite and > 0, got {g.tolist()}")
+    return g
+
+
+class Controller:
+    """A control law ``tau = controller(t, q, v)`` computed with ``model`` (fixed base).
+
+    A controller with an internal state ``z`` (integral action, parameter estimates of an
+    adaptive law) sets ``state0`` (nz,) and defines ``torque(t, q, v, z)`` and
+    ``state_rate(t, q, v, z) -> z'``; :func:`robodyn.simulate` integrates ``z`` with the
+    robot (and passes it to ``lyapunov(t, q, v, z)``). See :class:`PIDGravity`.
+    """
+
+    #: ``lyapunov(t, q, v) -> float`` where theory gives one, else None.
+    lyapunov = None
+    #: ``desired(t) -> (q_d, qd_d, qdd_d)`` (each (nv,)) for a joint-space reference, else None.
+    desired = None
+    #: Initial internal state (nz,) of a controller that has one, else None.
+    state0 = None
+    #: True when ``lyapunov(t, q, v)`` and ``desired(t)`` also take a whole trajectory:
+    #: ``t`` (N,), ``q``, ``v`` (N, nv) (evaluated at once after a simulation).
+    vectorized = False
+
+    def __init__(self, model):
+        if model.nq != model.nv:
+            raise ValueError(f"{type(self).__name__}: joint-space control needs a fixed-base model "
+                             f"(nq == nv), got nq={model.nq}, nv={model.nv}")
+        self.model = model
+
+    def __call__(self, t: float, q: np.ndarray, v: np.ndarray) -> np.ndarray:
+        raise NotImplementedError(f"{type(self).__name__} does not define its control law")
+
+    def kernel_law(self):
+        """``(law code, gains (2, nv), breaks, coefs)`` when :func:`robodyn.simulate` can run
+        this controller in compiled code (``simulation._kernels.law_torque``), else None."""
+        return None
+
+
+def _reference(model, reference):
+    if not callable(reference):
+        raise ValueError(f"reference: expected a callable t -> (q_d, qd_d, qdd_d), got {type(reference).__name__}")
+    q, v, a = (np.asarray(x, dtype=float) for x in reference(0.0))
+    for name, x in (("q_d", q), ("qd_d", v), ("qdd_d", a)):
+        if x.shape != (model.nv,):
+            raise ValueError(f"reference: {name} has shape {x.shape}, expected ({model.nv},)")
+    return reference
+
+
+class PDGravity(Controller):
+    """PD control with gravity compensation to a set point ``q_desired``:
+    ``tau = Kp (q_d - q) - Kd qd + g(q)``. With the exact gravity the set point is globally
+    asymptotically stable: ``V = qd^T M qd / 2 + e^T Kp e / 2`` has ``dV/dt = -qd^T Kd qd``
+    (minus the friction power). Spong et al. (2006), section 8.4."""
+
+    def __init__(self, model, q_desired, kp, kd):
+        super().__init__(model)
+        self.q_d = np.array(q_desired, dtype=float)
+        if self.q_d.shape != (model.nv,) or not np.all(np.isfinite(self.q_d)):
+            raise ValueError(f"q_desired: expected ({model.nv},) finite numbers, got shape {self.q_d.shape}")
+        self.kp, self.kd = gain("kp", kp, model.nv), gain("kd", kd, model.nv)
+        self._zero = np.zeros(model.nv)
+
+    def __call__(self, t, q, v):
+        return self.kp * (self.q_d - q) - self.kd * v + gravity(self.model, q)
+
+    def desired(self, t):
+        if np.ndim(t):
+            shape = (np.shape(t)[0], self.model.nv)
+            return np.broadcast_to(self.q_d, shape).copy(), np.zeros(shape), np.zeros(shape)
+        return self.q_d, self._zero, self._zero
+
+    def kernel_law(self):
+        if type(self).__call__ is not PDGravity.__call__:
+            return None
+        from ..simulation._kernels import PD_GRAVITY
+
+        return PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
+
+    vectorized = True
+
+    def lyapunov(self, t, q, v):
+        e = self.q_d - q
+        return 0.5 * np.einsum("...i,...ij,...j->...", v, crba(self.model, q), v) + 0.5 * np.sum(self.kp * e * e, -1)
+
+
+class PIDGravity(PDGravity):
+    """PID control with gravity compensation to a set point, with the integral of the error
+    as internal state ``z`` (``z' = q_d - q``, ``z(0) = 0``)::
+
+        tau = Kp e + Ki z - Kd qd + g(q)
+
+    The integral action removes the steady-state error left by a wrong gravity model or a
+    constant disturbance. Its stability needs conditions on the gains (Kelly, "Global
+    positioning of robot manipulators via PD control plus a class of nonlinear integral
+    actions", IEEE TAC 43(7), 1998); no Lyapunov function is reported. Called as
+    ``controller(t, q, v)`` outside a simulation it uses ``z = 0``.
+    """
+
+    lyapunov = None
+    vectorized = False
+
+    def __init__(self, model, q_desired, kp, ki, kd):
+        super().__init__(model, q_desired, kp, kd)
+        self.ki = gain("ki", ki, model.nv)
+        self.state0 = np.zeros(model.nv)
+
+    def torque(self, t, q, v, z):
+        return PDGravity.__call__(self, t, q, v) + self.ki * z
+
+    def state_rate(self, t, q, v, z):
+        return self.q_d - q
+
+    def __call__(self, t, q, v):
+        return self.torque(t, q, v, self.state0)
+
+
+class ComputedTorque(Controller):
+    """Inverse-dynamics (computed-torque) control on a reference ``t -> (q_d, qd_d, qdd_d)``:
+    ``tau = rnea(q, qd, qdd_d + Kd ed + Kp e)`` (the model's friction and armature
+    included). With the exact model the error obeys ``e'' + Kd e' + Kp e = 0``: each joint
+    converges exponentially (``Kp = w^2, Kd = 2 w``: critically damped at rate ``w``), and
+    ``V = ed^T ed / 2 + e^T Kp e / 2`` has ``dV/dt = -ed^T Kd ed``. Spong et al., section 8.3."""
+
+    def __init__(self, model, reference, kp, kd):
+        super().__init__(model)
+        self.reference = _reference(model, reference)
+        self.kp, self.kd = gain("kp", kp, model.nv), gain("kd", kd, model.nv)
+
+    def __call__(self, t, q, v):
+        q_d, v_d, a_d = self.reference(t)
+        return rnea(self.model, q, v, a_d + self.kd * (v_d - v) + self.kp * (q_d - q))
+
+    def kernel_law(self):
+        piecewise = getattr(self.reference, "piecewise_polynomial", None)
+        if type(self).__call__ is not ComputedTorque.__call__ or piecewise is None:
+            return None
+        from ..simulation._kernels import COMPUTED_TORQUE
+
+        breaks, coefs = piecewise()
+        return COMPUTED_TORQUE, np.stack([self.kp, self.kd]), breaks, coefs
+
+    def desired(self, t):
+        return self.reference(t)
+
+    @property
+    def vectorized(self):
+        return isinstance(self.reference, (PointToPoint, Sampled))
+
+    def lyapunov(self, t, q, v):
+        q_d, v_d, _ = self.reference(t)
+        e, ed = q_d - q, v_d - v
+        return 0.5 * np.sum(ed * ed, -1) + 0.5 * np.sum(self.kp * e * e, -1)
+
+
+class TaskSpacePD(Controller):
+    """PD control of the position of a link/frame ``frame`` to ``x_desired`` (world, (3,)),
+    with gravity compensation and joint damping ``D`` (for the redundant directions):
+    ``tau = J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``, ``J`` the (3, nv) linear Jacobian
+    of the frame origin in world axes. ``V = qd^T M qd / 2 + ex^T Kp ex / 2`` has
+    ``dV/dt = -(J qd)^T Kd (J qd) - qd^T D qd``. Siciliano et al. (2009), section 8.6.1."""
+
+    def __init__(self, model, frame: str, x_desired, kp, kd, joint_damping=1.0):
+        super().__init__(model)
+        b, self._R, self._p = model.frame_index(frame)
+        if b < 0:
+            raise ValueError(f"frame {frame!r} is fixed to the world; it cannot be moved")
+        self.frame, self._body = frame, b
+        self.x_d = np.array(x_desired, dtype=float)
+        if self.x_d.shape != (3,) or not np.all(np.isfinite(self.x_d)):
+            raise ValueError(f"x_desired: expected 3 finite numbers, got shape {self.x_d.shape}")
+        self.kp, self.kd = gain("kp", kp, 3), gain("kd", kd, 3)
+        self.damping = gain("joint_damping", joint_damping, model.nv)
+
+    def position_and_jacobian(self, q):
+        """World position (3,) of the frame origin and its linear Jacobian (3, nv) in world
+        axes (the rows ``[:3]`` of ``jacobian(model, q, frame, "local_world_aligned")``)."""
+        k = self.model._kernel
+        q = np.ascontiguousarray(q, dtype=float)
+        J, R, p = np.empty((6, self.model.nv)), np.empty((3, 3)), np.empty(3)
+        status = _kernels.body_jacobian(k["ints"], k["body"], k["dofs"][False, False], q, self._body, J, R, p)
+        raise_for_status(self.model, status, {"q": q}, "TaskSpacePD")
+        x = p + R @ self._p
+        x_cross = np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])
+        return x, J[:3] - x_cross @ J[3:]  # velocity of the point x: v_O + omega x x
+
+    def position(self, q):
+        """World position (3,) of the controlled frame."""
+        return self.position_and_jacobian(q)[0]
+
+    def __call__(self, t, q, v):
+        x, Jl = self.position_and_jacobian(q)
+        f = self.kp * (self.x_d - x) - self.kd * (Jl @ v)
+        return Jl.T @ f - self.damping * v + gravity(self.model, q)
+
+    def lyapunov(self, t, q, v):
+        ex = self.x_d - self.position(q)
+        return 0.5 * v @ crba(self.model, q) @ v + 0.5 * ex @ (self.kp * ex)
+
+
+class SlotineLi(Controller):
+    """Passivity-based tracking control (Slotine and Li, 1987) on a reference.
+
+    With ``q~ = q - q_d``, the reference velocity ``qd_r = qd_d - Lambda q~``, its derivative
+    ``qdd_r = qdd_d - Lambda (qd - qd_d)`` and the sliding variable ``s = qd - qd_r``::
+
+        tau = M(q) qdd_r + C(q, qd) qd_r + g(q) (+ friction) - Kd s
+
+    (:meth:`feedforward` computes the model terms as ``rnea(q, qd, qdd_r) - C(q, qd) s``.)
+    The closed loop ``M s' + (C + Kd) s = 0`` uses the skew-symmetry of ``Mdot - 2C``:
+    ``V = s^T M s / 2 + q~^T Lambda Kd q~`` has ``dV/dt = -q~'^T Kd q~' - q~^T Lambda Kd Lambda q~``.
+    An adaptive version replaces :meth:`feedforward` by ``Y(q, qd, qd_r, qdd_r) theta_hat``.
+    Spong et al. (2006), section 8.5.
+    """
+
+    def __init__(self, model, reference, lam, kd):
+        super().__init__(model)
+        self.reference = _reference(model, reference)
+        self.lam, self.kd = gain("lam", lam, model.nv), gain("kd", kd, model.nv)
+
+    def sliding(self, t, q, v):
+        """``(q~, qd_r, qdd_r, s)`` at time ``t``."""
+        q_d, v_d, a_d = self.reference(t)
+        e = q - q_d
+        v_r = v_d - self.lam * e
+        a_r = a_d - self.lam * (v - v_d)
+        return e, v_r, a_r, v - v_r
+
+    def feedforward(self, q, v, v_r, a_r):
+        """``M(q) qdd_r + C(q, qd) qd_r + g(q) + friction(qd)`` of the controller's model."""
+        return rnea(self.model, q, v, a_r) - coriolis_matrix(self.model, q, v) @ (v - v_r)
+
+    def __call__(self, t, q, v):
+        _, v_r, a_r, s = self.sliding(t, q, v)
+        return self.feedforward(q, v, v_r, a_r) - self.kd * s
+
+    def desired(self, t):
+        return self.reference(t)
+
+    @property
+    def vectorized(self):
+        return isinstance(self.reference, (PointToPoint, Sampled))
+
+    def lyapunov(self, t, q, v):
+        e, _, _, s = self.sliding(t, q, v)
+        return 0.5 * np.einsum("...i,...ij,...j->...", s, crba(self.model, q), s) + np.sum(self.lam * self.kd * e * e, -1)

@@ -1,0 +1,10 @@
+"""Simulation: forward dynamics integrated in time, free or under a controller.
+
+``simulate(model, q0, v0, duration, dt, controller=None, integrator="rk4")`` returns a
+:class:`Trajectory`; ``read_csv`` reads trajectories back (format in ``trajectory``).
+"""
+
+from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, simulate
+from .trajectory import Trajectory, coordinate_names, read_csv
+
+__all__ = ["simulate", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]

@@ -1,0 +1,226 @@
+"""Compiled steps of the simulation: the chart of the configuration manifold, the state
+derivative, and whole runs of the uncontrolled robot.
+
+One step from ``(q_n, v_n)`` integrates in the chart ``q = q_n ⊞ theta`` centred at ``q_n``
+(Runge-Kutta-Munthe-Kaas, Hairer, Lubich and Wanner, *Geometric Numerical Integration*,
+section IV.8): 1-dof joints ``q_n + theta``; a free joint's position ``p_n + theta_p`` (parent
+coordinates) and orientation ``R_n exp(phi)``. The chart's derivative is exact::
+
+    theta_p' = R(q) v_lin,    phi' = dexp^-1(phi) omega = omega + phi x omega / 2
+                                                 + c(t) phi x (phi x omega),
+    c(t) = (1 - (t / 2) cot(t / 2)) / t^2,  t = |phi|
+
+so any Runge-Kutta method applied to ``(theta, v)`` keeps its order and every stage lies on
+the manifold (unit quaternions by construction).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import inline, kernel
+from ..algorithms._inputs import OK
+from ..algorithms.aba import aba_one
+from ..algorithms.aba import workspace as aba_workspace
+from ..algorithms.rnea import rnea_one
+from ..algorithms.rnea import workspace as rnea_workspace
+from ..joints import FREE
+from ..spatial import rotation_from_quaternion
+
+SEMI_IMPLICIT_EULER = 0
+RK4 = 1
+
+# Control laws run in compiled code (``robodyn.control`` controllers' ``kernel_law``).
+CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
+PD_GRAVITY = 1       # Kp (q_d - q) - Kd qd + g(q)
+COMPUTED_TORQUE = 2  # rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))
+
+
+@inline
+def chart_point(ints, q0, theta, q):
+    """``q = q0 ⊞ theta`` (see the module docstring)."""
+    for i in range(ints.shape[0]):
+        jt, iq, iv = ints[i, 1], ints[i, 2], ints[i, 3]
+        if jt != FREE:
+            q[iq] = q0[iq] + theta[iv]
+            continue
+        for r in range(3):
+            q[iq + r] = q0[iq + r] + theta[iv + r]
+        wx, wy, wz = theta[iv + 3], theta[iv + 4], theta[iv + 5]
+        t = np.sqrt(wx * wx + wy * wy + wz * wz)
+        s = 0.5 - t * t / 48.0 if t < 1e-4 else np.sin(0.5 * t) / t
+        bx, by, bz, bw = s * wx, s * wy, s * wz, np.cos(0.5 * t)
+        ax, ay, az, aw = q0[iq + 3], q0[iq + 4], q0[iq + 5], q0[iq + 6]
+        x = aw * bx + bw * ax + ay * bz - az * by
+        y = aw * by + bw * ay + az * bx - ax * bz
+        z = aw * bz + bw * az + ax * by - ay * bx
+        w = aw * bw - ax * bx - ay * by - az * bz
+        n = np.sqrt(x * x + y * y + z * z + w * w)
+        q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6] = x / n, y / n, z / n, w / n
+
+
+@inline
+def chart_rate(ints, q, theta, v, R, out):
+    """``out = d theta / dt`` for velocity ``v`` at ``q = q0 ⊞ theta``; ``R`` is 3 x 3 workspace."""
+    for i in range(ints.shape[0]):
+        jt, iq, iv = ints[i, 1], ints[i, 2], ints[i, 3]
+        if jt != FREE:
+            out[iv] = v[iv]
+            continue
+        rotation_from_quaternion(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6], R)
+        for r in range(3):
+            out[iv + r] = R[r, 0] * v[iv] + R[r, 1] * v[iv + 1] + R[r, 2] * v[iv + 2]
+        px, py, pz = theta[iv + 3], theta[iv + 4], theta[iv + 5]
+        wx, wy, wz = v[iv + 3], v[iv + 4], v[iv + 5]
+        t = np.sqrt(px * px + py * py + pz * pz)
+        c = 1.0 / 12.0 + t * t / 720.0 if t < 1e-3 else (1.0 - 0.5 * t * np.cos(0.5 * t) / np.sin(0.5 * t)) / (t * t)
+        ux, uy, uz = py * wz - pz * wy, pz * wx - px * wz, px * wy - py * wx  # phi x omega
+        out[iv + 3] = wx + 0.5 * ux + c * (py * uz - pz * uy)
+        out[iv + 4] = wy + 0.5 * uy + c * (pz * ux - px * uz)
+        out[iv + 5] = wz + 0.5 * uz + c * (px * uy - py * ux)
+
+
+@inline
+def derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, check, tau, thetadot, a, R, ws):
+    """State derivative ``(theta', a)`` at ``q = q0 ⊞ theta``, velocity ``v``, for the command
+    ``tau_cmd`` clipped to ``[-limit, limit]`` (written to ``tau``). Returns the ABA status."""
+    for k in range(tau.shape[0]):
+        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
+    status = aba_one(ints, body, dofs, params, q, v, tau, fext, -1, check, a, ws)
+    chart_rate(ints, q, theta, v, R, thetadot)
+    return status
+
+
+@kernel
+def stage_workspace(nb, nq, nv):
+    """Workspace of ``stage``: ABA's, a 3 x 3 rotation."""
+    return aba_workspace(nb, nv), np.empty((3, 3))
+
+
+@kernel
+def point(ints, q0, theta, q):
+    """Compiled ``chart_point`` for the Python-driven integrators."""
+    chart_point(ints, q0, theta, q)
+
+
+@kernel
+def rate(ints, q, theta, v, R, out):
+    """Compiled ``chart_rate`` for the Python-driven integrators."""
+    chart_rate(ints, q, theta, v, R, out)
+
+
+@kernel
+def stage(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, tau, thetadot, a, ws, R):
+    """Compiled ``derivative`` (with the NaN/Inf check) for the Python-driven integrators."""
+    return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, True, tau, thetadot, a, R, ws)
+
+
+@inline
+def reference_at(breaks, coefs, t, qd, vd, ad):
+    """Piecewise polynomial reference (scipy ``PPoly`` layout: ``coefs[i, seg, j]`` multiplies
+    ``(t - breaks[seg])^(k - 1 - i)``) and its two derivatives at ``t``; outside
+    ``[breaks[0], breaks[-1]]`` it holds its end value at rest."""
+    m, k = breaks.shape[0] - 1, coefs.shape[0]
+    hold = t < breaks[0] or t > breaks[m]
+    if t < breaks[0]:
+        seg, x = 0, 0.0
+    else:
+        lo, hi = 0, m - 1  # the last segment with breaks[seg] <= t
+        while lo < hi:
+            mid = (lo + hi + 1) // 2
+            if breaks[mid] <= t:
+                lo = mid
+            else:
+                hi = mid - 1
+        seg = lo
+        x = min(t, breaks[m]) - breaks[seg]
+    for j in range(coefs.shape[2]):
+        p, dp, ddp = 0.0, 0.0, 0.0
+        for i in range(k):  # Horner's rule with the first two derivatives
+            ddp = ddp * x + 2.0 * dp
+            dp = dp * x + p
+            p = p * x + coefs[i, seg, j]
+        qd[j] = p
+        vd[j] = 0.0 if hold else dp
+        ad[j] = 0.0 if hold else ddp
+
+
+@inline
+def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
+    """The command of a compiled control law at ``(t, q, v)`` into ``out``; returns a status.
+
+    ``c = (ints, body, dofs_gravity, dofs_full, params, zero_wrench)`` of the controller's model
+    (``dofs_gravity`` without friction and armature, ``dofs_full`` with them);
+    ``gains[0] = Kp``, ``gains[1] = Kd``."""
+    if law == CONSTANT:
+        for k in range(out.shape[0]):
+            out[k] = tau_cmd[k]
+        return OK
+    ws, qd, vd, ad, acc, zero = cws
+    reference_at(breaks, coefs, t, qd, vd, ad)
+    if law == PD_GRAVITY:
+        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], -1, True, out, ws)
+        for k in range(out.shape[0]):
+            out[k] += gains[0, k] * (qd[k] - q[k]) - gains[1, k] * v[k]
+        return st
+    for k in range(out.shape[0]):
+        acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
+    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], -1, True, out, ws)
+
+
+@kernel
+def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, t0, dt,
+        Q, V, A, T):
+    """Integrate from ``(q0, v0)`` at time ``t0`` with ``Q.shape[0] - 1`` steps of ``dt`` under
+    a compiled control law (``law``, see ``law_torque``; ``CONSTANT`` applies ``tau_cmd``);
+    writes the samples ``Q, V``, the accelerations ``A`` and the applied torques ``T``.
+    Returns ``(status, sample)`` of the first failing evaluation (``(OK, -1)`` on success)."""
+    nv = v0.shape[0]
+    ws, R = stage_workspace(ints.shape[0], q0.shape[0], nv)
+    cws = (rnea_workspace(c[0].shape[0]), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv))
+    th = np.zeros(nv)
+    thi = np.empty(nv)
+    vi = np.empty(nv)
+    qi = np.empty(q0.shape[0])
+    ka = np.empty((4, nv))
+    kt = np.empty((4, nv))
+    tau = np.empty(nv)
+    cmd = np.empty(nv)
+    Q[0, :] = q0
+    V[0, :] = v0
+    n = Q.shape[0] - 1
+    for s in range(n + 1):
+        q, v, t = Q[s], V[s], t0 + s * dt
+        th[:] = 0.0
+        st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, cmd)
+        if st == OK:
+            st = derivative(ints, body, dofs, params, fext, limit, q, th, v, cmd, True, T[s], kt[0], A[s], R, ws)
+        if st != OK:
+            return st, s
+        if s == n:
+            break
+        if method == SEMI_IMPLICIT_EULER:
+            for k in range(nv):
+                V[s + 1, k] = v[k] + dt * A[s, k]
+            chart_rate(ints, q, th, V[s + 1], R, thi)
+            for k in range(nv):
+                thi[k] *= dt
+            chart_point(ints, q, thi, Q[s + 1])
+            continue
+        for k in range(nv):
+            ka[0, k] = A[s, k]
+        for j, h in ((1, 0.5 * dt), (2, 0.5 * dt), (3, dt)):
+            for k in range(nv):
+                thi[k] = h * kt[j - 1, k]
+                vi[k] = v[k] + h * ka[j - 1, k]
+            chart_point(ints, q, thi, qi)
+            st = law_torque(law, c, gains, breaks, coefs, t + h, qi, vi, tau_cmd, cws, cmd)
+            if st == OK:
+                st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, cmd, True, tau, kt[j], ka[j], R, ws)
+            if st != OK:
+                return st, s
+        for k in range(nv):
+            thi[k] = dt / 6.0 * (kt[0, k] + 2.0 * kt[1, k] + 2.0 * kt[2, k] + kt[3, k])
+            V[s + 1, k] = v[k] + dt / 6.0 * (ka[0, k] + 2.0 * ka[1, k] + 2.0 * ka[2, k] + ka[3, k])
+        chart_point(ints, q, thi, Q[s + 1])
+    return OK, -1

@@ -1,0 +1,342 @@
+"""Forward simulation of a robot, free or under a controller.
+
+    (M(q) + armature) qdd + C(q, qd) qd + g(q) + friction(qd) = clip(tau(t, q, qd), -tau_max, tau_max)
+
+integrated from ``(q0, v0)`` on the configuration manifold (see ``_kernels``): every
+integrator steps in a chart centred at the current configuration, so a floating base's
+quaternion stays of unit norm. The controller is evaluated at every stage of the integrator
+(a continuous-time control law), its command clipped to the model's effort limits
+(``Model.effort_limit``; infinite for no limit), and the model's joint friction
+(``damping``, ``coulomb``) and armature act on the motion.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+import numpy as np
+
+from .. import joints as J
+from ..algorithms._inputs import OK, raise_for_status
+from . import _kernels as K
+from .trajectory import Trajectory
+
+INTEGRATORS = ("semi_implicit_euler", "rk4")
+SCIPY_INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+
+# Runs of at least this many steps show a progress bar (when stderr is a terminal).
+PROGRESS_STEPS = 20000
+
+
+class Progress:
+    """A one-line progress bar on stderr: ``[#####     ]  50%  1.2 s``, shown only when
+    ``enabled`` (by default when stderr is a terminal)."""
+
+    def __init__(self, total: int, enabled: bool | None = None, width: int = 30, stream=None):
+        self.stream = sys.stderr if stream is None else stream
+        self.enabled = self.stream.isatty() if enabled is None else bool(enabled)
+        self.total, self.width, self.start, self.shown = max(int(total), 1), width, time.perf_counter(), -1
+
+    def update(self, done: int) -> None:
+        if not self.enabled:
+            return
+        pct = int(100 * done / self.total)
+        if pct == self.shown:
+            return
+        self.shown = pct
+        filled = self.width * pct // 100
+        elapsed = time.perf_counter() - self.start
+        self.stream.write(f"\r[{'#' * filled}{' ' * (self.width - filled)}] {pct:3d}%  {elapsed:.1f} s")
+        self.stream.flush()
+
+    def close(self) -> None:
+        if self.enabled:
+            self.update(self.total)
+            self.stream.write("\n")
+            self.stream.flush()
+
+
+def _vector(name: str, x, n: int) -> np.ndarray:
+    try:
+        a = np.array(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected an array of numbers, got {type(x).__name__}") from None
+    if a.shape != (n,):
+        raise ValueError(f"{name}: expected shape ({n},), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: contains NaN or Inf")
+    return a
+
+
+def _positive(name: str, x) -> float:
+    try:
+        x = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a number, got {x!r}") from None
+    if not (np.isfinite(x) and x > 0):
+        raise ValueError(f"{name}: must be finite and > 0, got {x}")
+    return x
+
+
+class _Law:
+    """The controller as the integrators see it: ``torque(t, q, v, z)`` and the rate of its
+    internal state ``z`` (empty for a stateless callable ``(t, q, v) -> tau``)."""
+
+    def __init__(self, controller, model):
+        self.controller = controller
+        if controller is None:
+            zero = np.zeros(model.nv)
+            self.controller = lambda t, q, v: zero
+        z0 = getattr(controller, "state0", None)
+        self.stateful = z0 is not None
+        self.z0 = np.zeros(0) if z0 is None else _vector("controller.state0", z0, np.size(z0))
+        self.nz = self.z0.shape[0]
+
+    def torque(self, t, q, v, z):
+        return self.controller.torque(t, q, v, z) if self.stateful else self.controller(t, q, v)
+
+    def rate(self, t, q, v, z, out):
+        if self.stateful:
+            r = np.asarray(self.controller.state_rate(t, q, v, z), dtype=float)
+            if r.shape != (self.nz,):
+                raise ValueError(f"controller: state_rate returned shape {r.shape} at t = {t}, expected ({self.nz},)")
+            out[:] = r
+
+
+class _Plant:
+    """The model's kernel arrays and the Python-driven stages of the integrators."""
+
+    def __init__(self, model):
+        k = model._kernel
+        self.model = model
+        self.args = (k["ints"], k["body"], k["dofs"][True, True], k["params"][True], k["zero_wrench"],
+                     np.ascontiguousarray(model.effort_limit))
+        self.ws, self.R = K.stage_workspace(model.nbodies, model.nq, model.nv)
+
+    def point(self, q0, theta, q):
+        K.point(self.args[0], q0, theta, q)
+
+    def rate(self, q, theta, v, out):
+        K.rate(self.args[0], q, theta, v, self.R, out)
+
+    def derivative(self, t, q, theta, v, law, z, tau, thetadot, a, zdot):
+        """``(theta', a, z')`` into the given arrays; the applied torque into ``tau``."""
+        law.rate(t, q, v, z, zdot)
+        cmd = law.torque(t, q, v, z)
+        if type(cmd) is not np.ndarray or cmd.dtype != np.float64 or cmd.shape != (self.model.nv,):
+            cmd = np.asarray(cmd, dtype=float)
+            if cmd.shape != (self.model.nv,):
+                raise ValueError(f"controller: returned shape {cmd.shape} at t = {t}, expected ({self.model.nv},)")
+        status = K.stage(*self.args, q, theta, v, cmd, tau, thetadot, a, self.ws, self.R)
+        if status != OK:
+            _raise(self.model, status, t, q, v, cmd)
+
+
+def _raise(model, status, t, q, v, tau):
+    """The error of an ABA status at time ``t``."""
+    try:
+        bad = raise_for_status(model, status, {"q": q, "v": v, "tau (controller output)": tau}, f"simulate at t = {t:.6g}")
+    except ValueError as e:
+        raise ValueError(f"{e}; the motion diverged or the controller returned NaN/Inf") from None
+    raise ValueError(f"simulate at t = {t:.6g}: the articulated inertia of body {bad - 1} "
+                     f"({model.link_names[bad - 1]!r}) is singular; the forward dynamics is undefined")
+
+
+def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str = "rk4", *,
+             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
+    """Simulate the robot from ``(q0, v0)`` for ``duration`` seconds, sampled every ``dt``.
+
+    Args:
+        q0: (nq,) initial configuration (unit quaternions). v0: (nv,) initial velocity.
+        duration, dt: seconds, ``> 0``; ``round(duration / dt)`` steps, samples at ``k dt``.
+        controller: None (no joint forces), or a callable ``(t, q, v) -> tau`` (nv,) such as
+            the controllers of :mod:`robodyn.control` (which may use another model than
+            ``model``: model mismatch). Its ``lyapunov(t, q, v)`` (when it has one) and its
+            reference ``desired(t) -> (q_d, v_d, a_d)`` are sampled into the trajectory.
+            The command is clipped to ``[-model.effort_limit, model.effort_limit]``.
+            A controller with an internal state (``state0`` (nz,), e.g. integral action or
+            parameter estimates) is called as ``torque(t, q, v, z)``, and its state is
+            integrated with the robot from ``z' = state_rate(t, q, v, z)``.
+        integrator: ``"rk4"`` (classic 4th-order Runge-Kutta in the manifold chart),
+            ``"semi_implicit_euler"`` (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), or a SciPy
+            ``solve_ivp`` method (``"RK45"``, ``"DOP853"``, ``"Radau"``, ...), adaptive between
+            samples with tolerances ``rtol``, ``atol``, restarted in a new chart at each sample.
+        progress: show a progress bar on stderr (None: when stderr is a terminal and the run
+            has at least ``PROGRESS_STEPS`` steps).
+
+    Returns:
+        :class:`Trajectory` (t, q, v, a, tau, energies, Lyapunov function, reference).
+
+    Without controller, and with the built-in :class:`robodyn.control.PDGravity` and
+    :class:`robodyn.control.ComputedTorque` (on a ``cubic``/``quintic``/``Sampled``
+    reference), the fixed-step integrators run entirely in compiled code; other callables
+    are called from a Python loop.
+    Reference: Hairer, Lubich, Wanner, *Geometric Numerical Integration* (2006), IV.8
+    (Runge-Kutta methods in local charts of a manifold).
+    """
+    q0 = _vector("q0", q0, model.nq)
+    v0 = _vector("v0", v0, model.nv)
+    duration, dt = _positive("duration", duration), _positive("dt", dt)
+    if dt > duration:
+        raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
+    if integrator not in INTEGRATORS + SCIPY_INTEGRATORS:
+        raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS + SCIPY_INTEGRATORS}")
+    if controller is not None and not callable(controller):
+        raise ValueError(f"controller: expected None or a callable (t, q, v) -> tau, got {type(controller).__name__}")
+    cmodel = getattr(controller, "model", None)
+    if cmodel is not None and (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
+        raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
+                         f"nq={model.nq}, nv={model.nv}")
+    for i in np.flatnonzero(model.joint_type == J.FREE):
+        k = model.idx_q[i] + 3
+        n = np.linalg.norm(q0[k:k + 4])
+        if abs(n - 1.0) > J.QUAT_TOL:
+            raise ValueError(f"q0: quaternion q0[{k}:{k + 4}] has norm {n:.6g}, not 1; normalise it")
+        q0[k:k + 4] /= n
+    n = max(1, int(round(duration / dt)))
+    t = np.arange(n + 1) * dt
+    Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))
+    A, T = np.zeros((n + 1, model.nv)), np.zeros((n + 1, model.nv))
+    bar = Progress(n, enabled=(n >= PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress)
+    plant, law = _Plant(model), _Law(controller, model)
+    Z = np.empty((n + 1, law.nz))
+    Z[0] = law.z0
+    compiled = None
+    if integrator in INTEGRATORS and not law.stateful:
+        compiled = (K.CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
+    if compiled is not None:
+        _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
+    elif integrator in INTEGRATORS:
+        _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
+    else:
+        _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
+    bar.close()
+    return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T)
+
+
+def _kernel_law(controller):
+    """The compiled form of a built-in controller (``kernel_law``), with its model's arrays."""
+    spec = getattr(controller, "kernel_law", None)
+    spec = spec() if callable(spec) else None
+    return None if spec is None else (spec[0], controller.model, *spec[1:])
+
+
+def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
+    """Compiled runs (no controller, or a built-in one), in pieces of about 1% of the run
+    when the progress bar is shown."""
+    law, cmodel, gains, breaks, coefs = compiled
+    model = plant.model
+    nv = model.nv
+    if law == K.CONSTANT:
+        cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
+    k = cmodel._kernel
+    c = (k["ints"], k["body"], k["dofs"][False, False], k["dofs"][True, True], k["params"][True], k["zero_wrench"])
+    n = Q.shape[0] - 1
+    method = K.RK4 if integrator == "rk4" else K.SEMI_IMPLICIT_EULER
+    zero = np.zeros(nv)
+    piece = max(1, n // 100) if bar.enabled else n
+    Q[0], V[0] = q0, v0
+    for a in range(0, n, piece):
+        b = min(n, a + piece)
+        status, s = K.run(*plant.args, c, law, gains, breaks, coefs, zero, method, Q[a].copy(), V[a].copy(), t[a],
+                          dt, Q[a:b + 1], V[a:b + 1], A[a:b + 1], T[a:b + 1])
+        if status != OK:
+            _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
+        bar.update(b)
+
+
+def _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar):
+    nq, nv, nz = Q.shape[1], V.shape[1], Z.shape[1]
+    n = Q.shape[0] - 1
+    zero = np.zeros(nv)
+    theta, qi, vi, zi, tau = np.empty(nv), np.empty(nq), np.empty(nv), np.empty(nz), np.empty(nv)
+    kt, ka, kz = np.empty((4, nv)), np.empty((4, nv)), np.empty((4, nz))
+    Q[0], V[0] = q0, v0
+    every = max(1, n // 100)
+    for s in range(n + 1):
+        q, v, z = Q[s], V[s], Z[s]
+        plant.derivative(t[s], q, zero, v, law, z, T[s], kt[0], A[s], kz[0])
+        if s == n:
+            break
+        if integrator == "semi_implicit_euler":
+            V[s + 1] = v + dt * A[s]
+            Z[s + 1] = z + dt * kz[0]
+            plant.rate(q, zero, V[s + 1], kt[1])
+            plant.point(q, dt * kt[1], Q[s + 1])
+        else:
+            ka[0] = A[s]
+            for j, h in ((1, 0.5 * dt), (2, 0.5 * dt), (3, dt)):
+                np.multiply(kt[j - 1], h, out=theta)
+                np.multiply(ka[j - 1], h, out=vi)
+                vi += v
+                np.multiply(kz[j - 1], h, out=zi)
+                zi += z
+                plant.point(q, theta, qi)
+                plant.derivative(t[s] + h, qi, theta, vi, law, zi, tau, kt[j], ka[j], kz[j])
+            V[s + 1] = v + dt / 6.0 * (ka[0] + 2.0 * ka[1] + 2.0 * ka[2] + ka[3])
+            Z[s + 1] = z + dt / 6.0 * (kz[0] + 2.0 * kz[1] + 2.0 * kz[2] + kz[3])
+            plant.point(q, dt / 6.0 * (kt[0] + 2.0 * kt[1] + 2.0 * kt[2] + kt[3]), Q[s + 1])
+        if s % every == 0:
+            bar.update(s)
+
+
+def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
+    """``solve_ivp`` on ``(theta, v, z)`` between consecutive samples, in the chart of the first."""
+    from scipy.integrate import solve_ivp
+
+    nq, nv, nz = Q.shape[1], V.shape[1], Z.shape[1]
+    n = Q.shape[0] - 1
+    zero = np.zeros(nv)
+    qi, tau, a = np.empty(nq), np.empty(nv), np.empty(nv)
+    dy = np.empty(2 * nv + nz)
+    Q[0], V[0] = q0, v0
+    every = max(1, n // 100)
+    for s in range(n + 1):
+        q = Q[s]
+        plant.derivative(t[s], q, zero, V[s], law, Z[s], T[s], dy[:nv], A[s], dy[2 * nv:])
+        if s == n:
+            break
+
+        def f(ti, y, q=q):
+            theta = y[:nv]
+            plant.point(q, theta, qi)
+            plant.derivative(ti, qi, theta, y[nv:2 * nv], law, y[2 * nv:], tau, dy[:nv], dy[nv:2 * nv], dy[2 * nv:])
+            return dy.copy()
+
+        y0 = np.concatenate([zero, V[s], Z[s]])
+        sol = solve_ivp(f, (t[s], t[s + 1]), y0, method=method, rtol=rtol, atol=atol)
+        if not sol.success:
+            raise ValueError(f"simulate: solve_ivp ({method}) failed between t = {t[s]:.6g} and {t[s + 1]:.6g}: "
+                             f"{sol.message}")
+        plant.point(q, sol.y[:nv, -1], Q[s + 1])
+        V[s + 1] = sol.y[nv:2 * nv, -1]
+        Z[s + 1] = sol.y[2 * nv:, -1]
+        if s % every == 0:
+            bar.update(s)
+
+
+def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Trajectory:
+    from ..algorithms.energy import kinetic_energy, potential_energy
+
+    kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
+    potential = potential_energy(model, Q)
+    lyapunov = q_d = v_d = None
+    vectorized = getattr(controller, "vectorized", False) and not law.stateful
+    if callable(getattr(controller, "lyapunov", None)):
+        if vectorized:
+            lyapunov = np.asarray(controller.lyapunov(t, Q, V), dtype=float)
+        else:
+            extra = (lambda k: (Z[k],)) if law.stateful else (lambda k: ())
+            lyapunov = np.array([controller.lyapunov(t[k], Q[k], V[k], *extra(k)) for k in range(t.shape[0])],
+                                dtype=float)
+    if callable(getattr(controller, "desired", None)):
+        if vectorized:
+            q_d, v_d, _ = (np.asarray(x, dtype=float) for x in controller.desired(t))
+        else:
+            ref = [controller.desired(ti) for ti in t]
+            q_d = np.array([r[0] for r in ref], dtype=float)
+            v_d = np.array([r[1] for r in ref], dtype=float)
+    return Trajectory(model=model, t=t, q=Q, v=V, a=A, tau=T, kinetic=kinetic, potential=potential,
+                      energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
+                      controller_state=Z if law.stateful else None, integrator=integrator)

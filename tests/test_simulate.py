@@ -1,0 +1,267 @@
+"""simulate: energy and momentum conservation, closed forms, order of accuracy, agreement
+between integrators and between the compiled and Python-driven paths, torque limits,
+friction, CSV round trip, progress bar and bad input."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import robodyn as rd
+from robodyn.random import random_model, random_state
+from robodyn.simulation import read_csv
+from robodyn.simulation.simulate import Progress
+
+from helpers import G, pendulum, rng_for
+
+PANDA_Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7])
+
+
+def zero_torque(model):
+    z = np.zeros(model.nv)
+    return lambda t, q, v: z
+
+
+def test_panda_energy_is_conserved():
+    """No torque, no friction: 2 s at dt = 1 ms with RK4 keeps the total energy within 1e-6."""
+    panda = rd.models.load("panda")
+    assert not np.any(panda.damping) and not np.any(panda.coulomb)
+    v0 = np.array([0.5, -0.3, 0.4, 0.2, -0.6, 0.5, 1.0])
+    traj = rd.simulate(panda, PANDA_Q0, v0, 2.0, 1e-3, integrator="rk4")
+    assert traj.t.shape == (2001,) and traj.t[-1] == pytest.approx(2.0)
+    assert abs(traj.energy[0]) > 10.0  # a relative criterion on a sizeable energy
+    assert np.abs(traj.energy - traj.energy[0]).max() <= 1e-6 * abs(traj.energy[0])
+    assert np.ptp(traj.kinetic) > 1.0  # the arm did move: energy was exchanged
+    # the recorded quantities are those of the states
+    np.testing.assert_allclose(traj.kinetic, rd.kinetic_energy(panda, traj.q, traj.v), rtol=1e-12)
+    np.testing.assert_allclose(traj.a, rd.aba(panda, traj.q, traj.v, traj.tau), rtol=1e-12, atol=1e-12)
+
+
+def spatial_momentum(model, q, v, about):
+    """Linear momentum (3,) and angular momentum (3,) about the point ``about`` (world)."""
+    T = rd.forward_kinematics(model, q)
+    lin, ang = np.zeros(3), np.zeros(3)
+    for i in range(model.nbodies):
+        theta = model.inertia[i]
+        m, R, p = theta[0], T[i, :3, :3], T[i, :3, 3]
+        if m == 0:
+            continue
+        c_local = theta[1:4] / m
+        Io = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
+        Ic = Io - m * (c_local @ c_local * np.eye(3) - np.outer(c_local, c_local))
+        twist = rd.jacobian(model, q, i, "world") @ v  # [velocity of the point at the origin, omega]
+        c = p + R @ c_local
+        cdot = twist[:3] + np.cross(twist[3:], c)
+        lin += m * cdot
+        ang += R @ Ic @ R.T @ twist[3:] + m * np.cross(c - about, cdot)
+    return lin, ang
+
+
+@pytest.mark.parametrize("gravity", [True, False], ids=["gravity", "no-gravity"])
+@pytest.mark.parametrize("seed", [5, 7])
+def test_floating_base_free_fall_keeps_momentum(seed, gravity):
+    """A floating tree without joint torques: linear momentum changes by m g t (zero without
+    gravity), angular momentum about the centre of mass is conserved."""
+    model = random_model(6, seed=seed, floating_base=True, branching=0.5)
+    if not gravity:
+        model = model.replace(gravity=np.zeros(3))
+    q0, v0, _ = random_state(model, rng_for("fall", seed))
+    traj = rd.simulate(model, q0, v0, 0.5, 1e-3)
+    mass = model.total_mass
+    lin0, ang0 = spatial_momentum(model, q0, v0, rd.center_of_mass(model, q0))
+    scale = max(np.linalg.norm(lin0), np.linalg.norm(ang0), mass * G * 0.5)
+    for k in (100, 250, 500):
+        q, v, t = traj.q[k], traj.v[k], traj.t[k]
+        lin, ang = spatial_momentum(model, q, v, rd.center_of_mass(model, q))
+        np.testing.assert_allclose(lin, lin0 + mass * model.gravity * t, rtol=0, atol=1e-8 * scale)
+        np.testing.assert_allclose(ang, ang0, rtol=0, atol=1e-8 * scale)
+    quats = traj.q[:, 3:7]
+    np.testing.assert_allclose(np.linalg.norm(quats, axis=1), 1.0, rtol=0, atol=1e-14)
+    assert np.ptp(traj.energy) <= 1e-8 * (abs(traj.energy[0]) + np.abs(traj.kinetic).max())
+
+
+def test_pendulum_matches_its_equation():
+    """The pendulum from the textbook ODE m L^2 qdd = m g L sin(q), solved by SciPy."""
+    m, L = 2.0, 0.7
+    model = pendulum(m, L)
+    traj = rd.simulate(model, [0.4], [0.0], 1.0, 1e-3)
+    ref = solve_ivp(lambda t, y: [y[1], G / L * np.sin(y[0])], (0, 1.0), [0.4, 0.0], t_eval=traj.t,
+                    rtol=1e-12, atol=1e-12, method="DOP853")
+    np.testing.assert_allclose(traj.q[:, 0], ref.y[0], rtol=0, atol=1e-9)
+    np.testing.assert_allclose(traj.v[:, 0], ref.y[1], rtol=0, atol=1e-8)
+
+
+def test_rk4_is_fourth_order_on_the_manifold():
+    """Halving dt divides the error of a floating-base run by about 2^4."""
+    model = random_model(5, seed=3, floating_base=True, branching=0.5)
+    q0, v0, _ = random_state(model, rng_for("order"))
+    fine = rd.simulate(model, q0, v0, 0.2, 2.5e-4)
+    errors = [np.abs(rd.difference(model, fine.q[-1], rd.simulate(model, q0, v0, 0.2, dt).q[-1])).max()
+              for dt in (4e-3, 2e-3)]
+    assert 12.0 < errors[0] / errors[1] < 20.0, errors
+
+
+@pytest.mark.parametrize("integrator", ["rk4", "semi_implicit_euler"])
+def test_compiled_and_python_paths_agree(integrator):
+    """controller=None runs compiled; a Python callable returning zeros is the same motion."""
+    model = random_model(4, seed=2, floating_base=True, branching=0.5)
+    q0, v0, _ = random_state(model, rng_for("paths"))
+    a = rd.simulate(model, q0, v0, 0.1, 1e-3, integrator=integrator)
+    b = rd.simulate(model, q0, v0, 0.1, 1e-3, controller=zero_torque(model), integrator=integrator)
+    for key in ("q", "v", "a", "tau", "energy"):
+        np.testing.assert_allclose(getattr(a, key), getattr(b, key), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("integrator", ["semi_implicit_euler", "RK45", "DOP853", "Radau"])
+def test_integrators_agree_with_rk4(integrator):
+    model = random_model(4, seed=6, floating_base=True, branching=0.5)
+    q0, v0, _ = random_state(model, rng_for("integrators"))
+    ref = rd.simulate(model, q0, v0, 0.05, 1e-3)
+    traj = rd.simulate(model, q0, v0, 0.05, 1e-3, integrator=integrator)
+    tol = 1e-3 if integrator == "semi_implicit_euler" else 1e-7
+    assert np.abs(rd.difference(model, ref.q, traj.q)).max() < tol
+    assert np.abs(traj.v - ref.v).max() < 100 * tol
+    assert traj.integrator == integrator
+
+
+def test_semi_implicit_euler_is_first_order():
+    model = rd.models.load("double_pendulum")
+    q0, v0 = np.array([0.3, -0.2]), np.zeros(2)
+    ref = rd.simulate(model, q0, v0, 0.2, 1e-4)
+    e = [np.abs(rd.simulate(model, q0, v0, 0.2, dt, integrator="semi_implicit_euler").q[-1] - ref.q[-1]).max()
+         for dt in (2e-3, 1e-3)]
+    assert 1.6 < e[0] / e[1] < 2.4, e
+
+
+def test_torques_are_clipped_to_the_effort_limits():
+    model = rd.models.load("double_pendulum").replace(effort_limit=[3.0, 1.0])
+    command = np.array([10.0, -5.0])
+    traj = rd.simulate(model, [0.1, 0.2], [0.0, 0.0], 0.05, 1e-3, controller=lambda t, q, v: command)
+    np.testing.assert_array_equal(traj.tau, np.tile([3.0, -1.0], (traj.t.shape[0], 1)))
+    np.testing.assert_allclose(traj.a, rd.aba(model, traj.q, traj.v, traj.tau), rtol=1e-12, atol=1e-12)
+
+
+def test_friction_dissipates_the_energy_it_should():
+    """dE/dt = -v^T (damping v + coulomb tanh(v / eps)) without torques."""
+    base = rd.models.load("double_pendulum")
+    model = base.replace(damping=[0.3, 0.2], coulomb=[0.1, 0.05], coulomb_smoothing=0.01)
+    traj = rd.simulate(model, [0.5, -0.3], [1.0, 0.0], 1.0, 1e-3)
+    power = -np.sum(traj.v * (model.damping * traj.v + model.coulomb * np.tanh(traj.v / 0.01)), axis=1)
+    dE = np.gradient(traj.energy, traj.t)
+    np.testing.assert_allclose(dE[5:-5], power[5:-5], rtol=0, atol=1e-4 * np.abs(power).max())
+    assert traj.energy[-1] < traj.energy[0] - 0.1
+
+
+def test_armature_energy_is_counted():
+    model = rd.models.load("double_pendulum").replace(armature=[0.05, 0.02])
+    traj = rd.simulate(model, [0.5, -0.3], [1.0, 0.5], 0.5, 1e-3)
+    assert np.ptp(traj.energy) < 1e-9 * abs(traj.energy).max()
+    np.testing.assert_allclose(traj.kinetic, rd.kinetic_energy(model, traj.q, traj.v)
+                               + 0.5 * (traj.v ** 2) @ model.armature, rtol=1e-12)
+
+
+def test_csv_round_trip(tmp_path):
+    model = random_model(3, seed=1, floating_base=True)
+    q0, v0, _ = random_state(model, rng_for("csv"))
+    traj = rd.simulate(model, q0, v0, 0.02, 1e-3)
+    path = tmp_path / "traj.csv"
+    traj.to_csv(path)
+    t, q, v, a = read_csv(model, path)
+    for mine, theirs in ((t, traj.t), (q, traj.q), (v, traj.v), (a, traj.a)):
+        np.testing.assert_allclose(mine, theirs, rtol=1e-15, atol=0)
+
+
+def test_csv_with_positions_only_is_differentiated(tmp_path):
+    model = rd.models.load("double_pendulum")
+    t = np.linspace(0, 1, 201)
+    q = np.stack([np.sin(2 * t), t ** 3], axis=1)
+    path = tmp_path / "q.csv"
+    np.savetxt(path, np.column_stack([t, q]), delimiter=",", header="t,q:joint1,q:joint2", comments="")
+    _, q_read, v, a = read_csv(model, path)
+    np.testing.assert_allclose(q_read, q, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(v[20:-20], np.stack([2 * np.cos(2 * t), 3 * t ** 2], 1)[20:-20], rtol=0, atol=1e-5)
+    np.testing.assert_allclose(a[20:-20], np.stack([-4 * np.sin(2 * t), 6 * t], 1)[20:-20], rtol=0, atol=1e-3)
+
+
+def test_csv_errors(tmp_path):
+    model = rd.models.load("double_pendulum")
+    path = tmp_path / "bad.csv"
+    path.write_text("t,q:joint1\n0,0\n1,1\n")
+    with pytest.raises(ValueError, match=r"missing columns \['q:joint2'\]"):
+        read_csv(model, path)
+    path.write_text("t,q:joint1,q:joint2\n0,0,0\n0,1,1\n")
+    with pytest.raises(ValueError, match="increase strictly"):
+        read_csv(model, path)
+    path.write_text("t,q:joint1,q:joint2\n0,0,nan\n1,1,1\n")
+    with pytest.raises(ValueError, match="NaN or Inf"):
+        read_csv(model, path)
+
+
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+def test_progress_bar_only_on_terminals():
+    out = _Terminal()
+    bar = Progress(200, stream=out)
+    for k in range(0, 201, 50):
+        bar.update(k)
+    bar.close()
+    text = out.getvalue()
+    assert "\r[" in text and " 50%" in text and "100%" in text and text.endswith("\n")
+    quiet = io.StringIO()
+    bar = Progress(200, stream=quiet)
+    bar.update(100)
+    bar.close()
+    assert quiet.getvalue() == ""
+
+
+def test_progress_bar_of_a_run(capfd):
+    model = rd.models.load("pendulum")
+    a = rd.simulate(model, [0.3], [0.0], 0.2, 1e-3, progress=True)
+    b = rd.simulate(model, [0.3], [0.0], 0.2, 1e-3)
+    assert "100%" in capfd.readouterr().err
+    np.testing.assert_array_equal(a.q, b.q)  # computed in pieces, same result
+
+
+def test_bad_input():
+    model = rd.models.load("double_pendulum")
+    ok = dict(q0=[0.1, 0.2], v0=[0.0, 0.0], duration=0.1, dt=1e-3)
+
+    def call(**kw):
+        args = {**ok, **kw}
+        return rd.simulate(model, args.pop("q0"), args.pop("v0"), args.pop("duration"), args.pop("dt"), **args)
+
+    with pytest.raises(ValueError, match=r"q0: expected shape \(2,\), got \(3,\)"):
+        call(q0=[0, 0, 0])
+    with pytest.raises(ValueError, match=r"v0: contains NaN"):
+        call(v0=[np.nan, 0])
+    with pytest.raises(ValueError, match=r"dt: must be finite and > 0, got 0"):
+        call(dt=0.0)
+    with pytest.raises(ValueError, match=r"dt: must be finite and > 0, got -0.001"):
+        call(dt=-1e-3)
+    with pytest.raises(ValueError, match=r"duration: must be finite and > 0, got inf"):
+        call(duration=np.inf)
+    with pytest.raises(ValueError, match=r"dt: must not exceed duration"):
+        call(dt=1.0)
+    with pytest.raises(ValueError, match=r"integrator: unknown 'euler'"):
+        call(integrator="euler")
+    with pytest.raises(ValueError, match=r"controller: expected None or a callable"):
+        call(controller="pd")
+    with pytest.raises(ValueError, match=r"controller: returned shape \(3,\) at t = 0"):
+        call(controller=lambda t, q, v: np.zeros(3))
+    with pytest.raises(ValueError, match=r"tau \(controller output\) contains NaN"):
+        call(controller=lambda t, q, v: np.array([0.0, np.nan]) if t > 0.05 else np.zeros(2))
+    from robodyn import control
+
+    with pytest.raises(ValueError, match=r"controller: its model has nq=7, nv=7; the simulated model has nq=2"):
+        call(controller=control.PDGravity(rd.models.load("panda"), np.zeros(7), 1.0, 1.0))
+    floating = random_model(2, seed=0, floating_base=True)
+    q0, v0, _ = random_state(floating, rng_for("quat"))
+    q0[3:7] *= 1.5
+    with pytest.raises(ValueError, match=r"q0: quaternion q0\[3:7\] has norm 1.5"):
+        rd.simulate(floating, q0, v0, 0.1, 1e-3)
