@@ -21,6 +21,7 @@ _LAZY = {
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
     "nonlinear_effects": "terms", "integrate": "integrate", "difference": "integrate",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
+    "slotine_li_regressor": "regressor",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
@@ -61,4 +62,5 @@ __all__ = [
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
+    "slotine_li_regressor",
 ]
