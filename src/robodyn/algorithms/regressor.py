@@ -271,6 +271,11 @@ def _energy_regressor_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nc
                                              OUT[s], ws)
 
 
+@kernel
+def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
+    return energy_regressor_one(ints, body, dofs, grav, q, v, check, out, workspace(ints.shape[0], dofs.shape[0]))
+
+
 def extra_columns(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
                   offset: bool = False) -> list[str]:
     """Names of the extra regressor columns, in order: ``"viscous[joint]"``, ... one per dof."""
@@ -406,8 +411,11 @@ def _energy(model, check_finite, what, **arrays):
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2, 10 * model.nbodies)), np.empty(B, dtype=np.int64)
-    _energy_regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite,
-                            OUT, status, _inputs.chunks(B))
+    args = (k["ints"], k["body"], k["dofs"][(False, False)], model.gravity)
+    if B == 1:  # one state: no thread start-up of the batch driver
+        status[0] = _energy_regressor_single(*args, Q[0], V[0], check_finite, OUT[0])
+    else:
+        _energy_regressor_batch(*args, Q, V, check_finite, OUT, status, _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return OUT.reshape(batch + OUT.shape[1:])
 
