@@ -255,7 +255,8 @@ class SlotineLi(Controller):
     (:meth:`feedforward` computes the model terms as ``rnea(q, qd, qdd_r) - C(q, qd) s``.)
     The closed loop ``M s' + (C + Kd) s = 0`` uses the skew-symmetry of ``Mdot - 2C``:
     ``V = s^T M s / 2 + q~^T Lambda Kd q~`` has ``dV/dt = -q~'^T Kd q~' - q~^T Lambda Kd Lambda q~``.
-    An adaptive version replaces :meth:`feedforward` by ``Y(q, qd, qd_r, qdd_r) theta_hat``.
+    The adaptive version, :class:`AdaptiveSlotineLi`, replaces :meth:`feedforward` by
+    ``Y(q, qd, qd_r, qdd_r) theta_hat``.
     Spong et al. (2006), section 8.5.
     """
 
