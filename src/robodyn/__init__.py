@@ -26,6 +26,7 @@ _LAZY = {
     "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
+    "slotine_li_regressor": "regressor",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
@@ -69,4 +70,5 @@ __all__ = [
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
+    "slotine_li_regressor",
 ]

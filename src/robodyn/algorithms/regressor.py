@@ -5,6 +5,7 @@ the body origin in the body frame, order ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, 
 Izz]``, as in ``Model.inertial_parameters()``):
 
     tau = Y(q, v, a) theta                       (joint-torque regressor, nv x 10 nb)
+    M qdd_r + C(q, v) qd_r + g = Y(q, v, qd_r, qdd_r) theta    (Slotine-Li regressor, nv x 10 nb)
     T(q, v) = Y_T(q, v) theta,  U(q) = Y_U(q) theta    (energy regressors, 10 nb)
 
 Body ``i``'s spatial force ``f_i = I_i a_i + v_i x* I_i v_i`` (body frame, with the base
@@ -43,9 +44,9 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, inline, kernel, parallel
-from ..spatial import dot6, force_act, force_cross, inertia_mul
+from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
 from . import _inputs
-from ._inputs import NONFINITE, OK, finite
+from ._inputs import NONFINITE, OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass
 
@@ -71,36 +72,29 @@ def body_regressor(E, vel, acc, W, t1, t2):
             W[c, r] += t2[r]
 
 
-@core
-def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
-    """Joint-torque regressor of one state into ``Y`` (nv, 10 nb + extra columns); returns a
-    status (see ``_inputs``). Columns past ``10 nb`` are the extra blocks in the order of
-    ``EXTRA_COLUMNS`` whose flags ``params[4:8]`` are non-zero."""
-    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
-    nb, nv = ints.shape[0], dofs.shape[0]
-    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
-    if status != OK:
-        return status
-    if check and not finite(a):
-        return NONFINITE
-    motion_pass(ints, dofs, liR, lip, v, a, params, vel, acc, vJ, t1, t2)
-    for k in range(nv):
-        for c in range(Y.shape[1]):
-            Y[k, c] = 0.0
-    for i in range(nb):
-        body_regressor(E, vel[i], acc[i], W, t1, t2)
-        j = i
-        while j >= 0:  # W holds A_i expressed in body j's frame
-            for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
-                for c in range(10):
-                    Y[k, 10 * i + c] = dot6(dofs[k, :6], W[c])
-            if ints[j, 0] >= 0:
-                for c in range(10):
-                    force_act(liR[j], lip[j], W[c], t1)
-                    for r in range(6):
-                        W[c, r] = t1[r]
-            j = ints[j, 0]
-    col, eps = 10 * nb, params[3]
+@inline
+def joint_rows(ints, dofs, liR, lip, i, W, Y, t1):
+    """Columns ``10 i : 10 i + 10`` of ``Y`` from body ``i``'s regressor ``W`` (10, 6) in body
+    ``i`` coordinates: ``Y[k] = S_k^T jX*_i W`` for the dofs ``k`` of ``i`` and of each
+    ancestor ``j``. ``W`` is carried up the chain (overwritten)."""
+    j = i
+    while j >= 0:  # W holds A_i expressed in body j's frame
+        for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+            for c in range(10):
+                Y[k, 10 * i + c] = dot6(dofs[k, :6], W[c])
+        if ints[j, 0] >= 0:
+            for c in range(10):
+                force_act(liR[j], lip[j], W[c], t1)
+                for r in range(6):
+                    W[c, r] = t1[r]
+        j = ints[j, 0]
+
+
+@inline
+def extra_rows(params, v, a, col, Y):
+    """The extra column blocks from column ``col`` on (flags ``params[4:8]``, see
+    ``EXTRA_COLUMNS``): ``v_k``, ``sgn v_k`` (smoothed when ``params[3] > 0``), ``a_k``, ``1``."""
+    nv, eps = v.shape[0], params[3]
     for block in range(4):
         if params[4 + block] == 0.0:
             continue
@@ -115,6 +109,26 @@ def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
             else:
                 Y[k, col + k] = 1.0
         col += nv
+
+
+@core
+def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
+    """Joint-torque regressor of one state into ``Y`` (nv, 10 nb + extra columns); returns a
+    status (see ``_inputs``). Columns past ``10 nb`` are the extra blocks in the order of
+    ``EXTRA_COLUMNS`` whose flags ``params[4:8]`` are non-zero."""
+    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
+    nb = ints.shape[0]
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    if check and not finite(a):
+        return NONFINITE
+    motion_pass(ints, dofs, liR, lip, v, a, params, vel, acc, vJ, t1, t2)
+    Y[:, :] = 0.0
+    for i in range(nb):
+        body_regressor(E, vel[i], acc[i], W, t1, t2)
+        joint_rows(ints, dofs, liR, lip, i, W, Y, t1)
+    extra_rows(params, v, a, 10 * nb, Y)
     return OK
 
 
@@ -125,6 +139,105 @@ def _regressor_batch(ints, body, dofs, params, Q, V, A, check, Y, status, nchunk
         ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
             status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+
+
+@kernel
+def reference_workspace(nb, nv):
+    """:func:`workspace` plus the reference velocities (nb, 6) and two 6-vectors."""
+    liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = workspace(nb, nv)
+    return (liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, np.empty((nb, 6)), np.empty(6), np.empty(6))
+
+
+@inline
+def reference_motion_pass(ints, dofs, liR, lip, v, v_r, a_r, grav, vel, vel_r, acc_r, vJ, t1, a0):
+    """Body velocities ``vel``, reference velocities ``vel_r`` and reference accelerations
+    ``acc_r`` (nb, 6) in body coordinates, the base accelerating at ``-grav``::
+
+        v_i = iX_p v_p + S_i qd_i,   v_r,i = iX_p v_r,p + S_i qd_r,i,
+        a_r,i = iX_p a_r,p + S_i qdd_r,i + v_i x S_i qd_r,i
+
+    (``a_r,i = J_i qdd_r + Jdot_i qd_r``: the joint axes move with the true velocity).
+    """
+    for k in range(6):
+        a0[k] = 0.0
+    a0[0], a0[1], a0[2] = -grav[0], -grav[1], -grav[2]
+    for i in range(ints.shape[0]):
+        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+            motion_act_inv(liR[i], lip[i], vel_r[par], vel_r[i])
+            motion_act_inv(liR[i], lip[i], acc_r[par], acc_r[i])
+        else:
+            vel[i, :] = 0.0
+            vel_r[i, :] = 0.0
+            motion_act_inv(liR[i], lip[i], a0, acc_r[i])
+        for r in range(6):
+            vJ[r] = 0.0
+        for k in range(iv, iv + n):
+            for r in range(6):
+                vel[i, r] += dofs[k, r] * v[k]
+                vJ[r] += dofs[k, r] * v_r[k]
+                acc_r[i, r] += dofs[k, r] * a_r[k]
+        for r in range(6):
+            vel_r[i, r] += vJ[r]
+        motion_cross(vel[i], vJ, t1)
+        for r in range(6):
+            acc_r[i, r] += t1[r]
+
+
+@inline
+def body_reference_regressor(E, vel, vel_r, acc_r, W, w, t1, t2):
+    """``W[c] = I(e_c) a_r + B(e_c, v) v_r`` (10, 6) with
+    ``B(v) v_r = 1/2 [ v x* I v_r + v_r x* I v - I (v x v_r) ]``; ``w`` (6,) a workspace."""
+    motion_cross(vel, vel_r, w)
+    for c in range(10):
+        inertia_mul(E[c], acc_r, W[c])
+        inertia_mul(E[c], w, t1)
+        for r in range(6):
+            W[c, r] -= 0.5 * t1[r]
+        inertia_mul(E[c], vel_r, t1)
+        force_cross(vel, t1, t2)
+        for r in range(6):
+            W[c, r] += 0.5 * t2[r]
+        inertia_mul(E[c], vel, t1)
+        force_cross(vel_r, t1, t2)
+        for r in range(6):
+            W[c, r] += 0.5 * t2[r]
+
+
+@core
+def slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y, ws):
+    """Slotine-Li regressor of one state into ``Y`` (nv, 10 nb + extra columns, as
+    :func:`regressor_one` with ``a = a_r``); returns a status (see ``_inputs``)."""
+    liR, lip, oR, op, Rj, pj, vel, acc_r, vJ, t1, t2, E, W, vel_r, w, a0 = ws
+    nb = ints.shape[0]
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    if status != OK:
+        return status
+    if check and not (finite(v_r) and finite(a_r)):
+        return NONFINITE
+    reference_motion_pass(ints, dofs, liR, lip, v, v_r, a_r, params, vel, vel_r, acc_r, vJ, t1, a0)
+    Y[:, :] = 0.0
+    for i in range(nb):
+        body_reference_regressor(E, vel[i], vel_r[i], acc_r[i], W, w, t1, t2)
+        joint_rows(ints, dofs, liR, lip, i, W, Y, t1)
+    extra_rows(params, v, a_r, 10 * nb, Y)
+    return result_status(check, finite2(Y))
+
+
+@parallel
+def _slotine_li_batch(ints, body, dofs, params, Q, V, VR, AR, check, Y, status, nchunk):
+    B = Q.shape[0]
+    for c in prange(nchunk):
+        ws = reference_workspace(ints.shape[0], dofs.shape[0])
+        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
+            status[s] = slotine_li_regressor_one(ints, body, dofs, params, Q[s], V[s], VR[s], AR[s], check, Y[s], ws)
+
+
+@kernel
+def _slotine_li_single(ints, body, dofs, params, q, v, v_r, a_r, check, Y):
+    return slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y,
+                                    reference_workspace(ints.shape[0], dofs.shape[0]))
 
 
 @core
@@ -161,6 +274,11 @@ def _energy_regressor_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nc
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
             status[s] = energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check,
                                              OUT[s], ws)
+
+
+@kernel
+def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
+    return energy_regressor_one(ints, body, dofs, grav, q, v, check, out, workspace(ints.shape[0], dofs.shape[0]))
 
 
 def extra_columns(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
@@ -237,6 +355,60 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
 
+def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, coulomb: bool = False,
+                         armature: bool = False, offset: bool = False, check_finite: bool = True) -> np.ndarray:
+    """Slotine-Li regressor ``Y(q, qd, qd_r, qdd_r)``, linear in the inertial parameters::
+
+        Y @ model.inertial_parameters() == M(q) qdd_r + C(q, qd) qd_r + g(q)
+
+    with ``C`` the Coriolis matrix of :func:`robodyn.coriolis_matrix` (``Mdot - 2C``
+    skew-symmetric, which the passivity of the adaptive Slotine-Li controller needs; the
+    Coriolis vector alone does not fix ``C qd_r``). With ``v_ref = v`` it is
+    :func:`regressor`. Body by body (body coordinates, base accelerating at ``-g``)::
+
+        v_i   = iX_p v_p   + S_i qd_i
+        v_r,i = iX_p v_r,p + S_i qd_r,i
+        a_r,i = iX_p a_r,p + S_i qdd_r,i + v_i x S_i qd_r,i
+        f_i   = I_i a_r,i + B_i(v_i) v_r,i,  B(v) = 1/2 [(v x*) I - I (v x) + (I v) xbar*]
+
+    (``(f xbar*) m = m x* f``), linear in body ``i``'s 10 parameters; ``tau = sum_i J_i^T
+    f_i`` is accumulated up each body's chain as in :func:`regressor`, since
+    ``C = sum_i J_i^T (I_i Jdot_i + B_i J_i)`` (Echeandia and Wensing 2021).
+
+    Args:
+        q: (..., nq) configuration. v: (..., nv) velocity ``qd``. v_ref, a_ref: (..., nv)
+            reference velocity ``qd_r`` and acceleration ``qdd_r``.
+        viscous, coulomb, armature, offset: extra ``nv``-column blocks as in :func:`regressor`,
+            evaluated at ``(v, a_ref)``: ``v_k``, ``sgn v_k``, ``qdd_r,k``, ``1``; with them,
+            ``Y @ extended_parameters(model, ...) == rnea(q, v, a_ref) - C(q, v) (v - v_ref)``
+            (+ offset): the friction of the true velocity and the armature at ``qdd_r``.
+        check_finite: reject NaN/Inf inputs.
+
+    Returns:
+        Y: (..., nv, 10 nbodies + extra columns). For a floating base the first six rows are
+        the base wrench ``[force, torque]`` in the base frame, as in ``rnea``.
+
+    Reference: Slotine and Li, "On the adaptive control of robot manipulators", IJRR 6(3),
+    1987; Niemeyer and Slotine, "Performance in adaptive manipulator control", IJRR 10(2),
+    1991; Echeandia and Wensing, J. Comput. Nonlinear Dynam. 16(9), 2021.
+    """
+    batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
+    k = model._kernel
+    flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
+    params = np.concatenate([k["params"][True], flags])
+    ncol = 10 * model.nbodies + model.nv * int(sum(flags))
+    args = (k["ints"], k["body"], k["dofs"][(False, False)], params)
+    if batch == ():
+        Y = np.empty((model.nv, ncol))
+        status = _slotine_li_single(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y)
+    else:
+        B = x["q"].shape[0]
+        Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
+        _slotine_li_batch(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y, status, _inputs.chunks(B))
+    _inputs.raise_for_status(model, status, x, "slotine_li_regressor")
+    return _inputs.unflatten(Y, batch)
+
+
 def _energy(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
     k = model._kernel
@@ -244,8 +416,11 @@ def _energy(model, check_finite, what, **arrays):
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2, 10 * model.nbodies)), np.empty(B, dtype=np.int64)
-    _energy_regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite,
-                            OUT, status, _inputs.chunks(B))
+    args = (k["ints"], k["body"], k["dofs"][(False, False)], model.gravity)
+    if B == 1:  # one state: no thread start-up of the batch driver
+        status[0] = _energy_regressor_single(*args, Q[0], V[0], check_finite, OUT[0])
+    else:
+        _energy_regressor_batch(*args, Q, V, check_finite, OUT, status, _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return OUT.reshape(batch + OUT.shape[1:])
 

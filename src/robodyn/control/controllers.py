@@ -14,6 +14,8 @@ PIDGravity          ``Kp e + Ki int(e) - Kd qd + g(q)``                      (no
 ComputedTorque      ``M (qdd_d + Kd ed + Kp e) + C qd + g (+ friction)``     ``ed^T ed / 2 + e^T Kp e / 2``
 TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``           ``qd^T M qd / 2 + ex^T Kp ex / 2``
 SlotineLi           ``M qdd_r + C qd_r + g (+ friction) - Kd s``             ``s^T M s / 2 + q~^T Lambda Kd q~``
+AdaptiveSlotineLi   ``Y(q, qd, qd_r, qdd_r) theta_hat - Kd s``,              ``s^T M s / 2 + q~^T Lambda Kd q~``
+                    ``theta_hat' = -Gamma^-1 Y^T s``                         ``+ theta~^T Gamma theta~ / 2``
 =================== ======================================================== ===================================
 
 References: Spong, Hutchinson, Vidyasagar, *Robot Modeling and Control* (2006), chapter 8
@@ -29,6 +31,7 @@ import numpy as np
 from ..algorithms._inputs import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
+from ..algorithms.regressor import extended_parameters, kinetic_energy_regressor, slotine_li_regressor
 from ..algorithms.rnea import rnea
 from ..algorithms.terms import gravity
 from . import _kernels
@@ -252,9 +255,8 @@ class SlotineLi(Controller):
     (:meth:`feedforward` computes the model terms as ``rnea(q, qd, qdd_r) - C(q, qd) s``.)
     The closed loop ``M s' + (C + Kd) s = 0`` uses the skew-symmetry of ``Mdot - 2C``:
     ``V = s^T M s / 2 + q~^T Lambda Kd q~`` has ``dV/dt = -q~'^T Kd q~' - q~^T Lambda Kd Lambda q~``.
-    An adaptive version replaces :meth:`feedforward` by ``Y(q, qd, qd_r, qdd_r) theta_hat``
-    with the estimates ``theta_hat`` as internal state (``state0``, ``torque(t, q, v, z)``,
-    ``state_rate = -Gamma Y^T s``; see :class:`Controller`).
+    The adaptive version, :class:`AdaptiveSlotineLi`, replaces :meth:`feedforward` by
+    ``Y(q, qd, qd_r, qdd_r) theta_hat``.
     Spong et al. (2006), section 8.5.
     """
 
@@ -289,3 +291,128 @@ class SlotineLi(Controller):
     def lyapunov(self, t, q, v):
         e, _, _, s = self.sliding(t, q, v)
         return 0.5 * np.einsum("...i,...ij,...j->...", s, crba(self.model, q), s) + np.sum(self.lam * self.kd * e * e, -1)
+
+
+def _gain_matrix(name: str, value, n: int) -> np.ndarray:
+    """A symmetric positive-definite (n, n) gain matrix from a scalar, an (n,) diagonal or an
+    (n, n) matrix."""
+    if np.ndim(value) < 2:
+        return np.diag(gain(name, value, n))
+    G = np.asarray(value, dtype=float)
+    if G.shape != (n, n):
+        raise ValueError(f"{name}: expected a positive number, shape ({n},) or ({n}, {n}), got {G.shape}")
+    if not np.all(np.isfinite(G)) or not np.allclose(G, G.T, rtol=1e-12, atol=0.0):
+        raise ValueError(f"{name}: the matrix must be finite and symmetric")
+    try:
+        np.linalg.cholesky(G)
+    except np.linalg.LinAlgError:
+        raise ValueError(f"{name}: the matrix must be positive definite") from None
+    return G
+
+
+class AdaptiveSlotineLi(SlotineLi):
+    """Adaptive Slotine-Li control (Slotine and Li, 1987): :class:`SlotineLi` with the model
+    terms computed from estimated parameters ``theta_hat``, the controller's internal state::
+
+        tau = Y(q, qd, qd_r, qdd_r) theta_hat - Kd s,      theta_hat' = -Gamma^-1 Y^T s
+
+    with ``Y`` the :func:`robodyn.slotine_li_regressor` of the controller's model (only its
+    kinematics is used: joints, placements, gravity) and ``q~``, ``qd_r``, ``qdd_r``, ``s``
+    as in :class:`SlotineLi`. ``theta_hat`` (10 per body, order of
+    ``Model.inertial_parameters()``, then the optional ``viscous``, ``coulomb`` and
+    ``armature`` blocks of ``nv`` each, see :func:`robodyn.algorithms.regressor.extended_parameters`)
+    starts at ``theta0`` (default: the controller model's own parameters).
+
+    If the plant is exactly ``Y theta`` for some ``theta`` (its friction and armature modelled
+    by the chosen columns, torques not saturated), the closed loop is
+    ``M s' + (C + Kd) s = Y theta~`` (``theta~ = theta_hat - theta``) and, with the
+    skew-symmetry of ``Mdot - 2C``,
+
+        V = s^T M s / 2 + q~^T Lambda Kd q~ + theta~^T Gamma theta~ / 2,
+        dV/dt = -q~'^T Kd q~' - q~^T Lambda Kd Lambda q~ <= 0
+
+    so ``q~ -> 0`` and ``q~' -> 0`` (Barbalat's lemma) for any bounded reference with bounded
+    derivatives. The estimates stay bounded but converge to ``theta`` only under persistent
+    excitation. ``V`` needs the plant's true ``theta``: pass ``theta_true`` (an array, or the
+    plant's ``Model``, whose parameters are taken with the same columns) to get
+    ``lyapunov(t, q, v, z)`` (sampled by :func:`robodyn.simulate`), or call
+    :meth:`lyapunov_with`. Called as ``controller(t, q, v)`` outside a simulation it uses
+    ``theta_hat = theta0``.
+
+    Args:
+        lam, kd: ``Lambda`` and ``Kd``, scalars or (nv,) (diagonal), > 0.
+        gamma: ``Gamma``, a scalar, an (np,) diagonal or an (np, np) symmetric
+            positive-definite matrix (np parameters): the larger, the slower the adaptation.
+        theta0: (np,) initial estimate.
+        viscous, coulomb, armature: also estimate viscous friction (column ``qd_k``), Coulomb
+            friction (``sgn qd_k``, smoothed as in the controller model) and armature
+            (``qdd_r,k``) of each joint.
+
+    References: Slotine and Li, IJRR 6(3), 1987; Spong, Hutchinson and Vidyasagar (2006),
+    section 8.5.2; Siciliano et al. (2009), section 8.5.4.
+    """
+
+    def __init__(self, model, reference, lam, kd, gamma, theta0=None, *, theta_true=None, viscous: bool = False,
+                 coulomb: bool = False, armature: bool = False):
+        super().__init__(model, reference, lam, kd)
+        self.columns = dict(viscous=bool(viscous), coulomb=bool(coulomb), armature=bool(armature))
+        self.state0 = self._parameters("theta0", model if theta0 is None else theta0)
+        n = self.state0.shape[0]
+        self.gamma = _gain_matrix("gamma", gamma, n)
+        diagonal = not np.any(self.gamma - np.diag(np.diag(self.gamma)))
+        self._gamma_inv = 1.0 / np.diag(self.gamma) if diagonal else np.linalg.inv(self.gamma)
+        self.theta_true = None if theta_true is None else self._parameters("theta_true", theta_true)
+
+    def _parameters(self, name, theta):
+        """A parameter vector (np,) from an array or a model with the same joints."""
+        if hasattr(theta, "inertial_parameters"):
+            if (theta.nq, theta.nv, theta.nbodies) != (self.model.nq, self.model.nv, self.model.nbodies):
+                raise ValueError(f"{name}: the model has nq={theta.nq}, nv={theta.nv}, {theta.nbodies} bodies; the "
+                                 f"controller's has nq={self.model.nq}, nv={self.model.nv}, "
+                                 f"{self.model.nbodies} bodies")
+            return extended_parameters(theta, **self.columns)
+        n = 10 * self.model.nbodies + self.model.nv * sum(self.columns.values())
+        x = np.array(theta, dtype=float)
+        if x.shape != (n,) or not np.all(np.isfinite(x)):
+            raise ValueError(f"{name}: expected ({n},) finite numbers (10 per body, then {self.model.nv} per "
+                             f"extra column block), got shape {x.shape}")
+        return x
+
+    def regressor(self, t, q, v):
+        """``(Y, s)``: the Slotine-Li regressor (nv, np) at ``(q, qd, qd_r, qdd_r)`` and ``s``."""
+        _, v_r, a_r, s = self.sliding(t, q, v)
+        return slotine_li_regressor(self.model, q, v, v_r, a_r, **self.columns), s
+
+    def torque(self, t, q, v, z):
+        Y, s = self.regressor(t, q, v)
+        return Y @ z - self.kd * s
+
+    def state_rate(self, t, q, v, z):
+        Y, s = self.regressor(t, q, v)
+        g = Y.T @ s
+        return -(self._gamma_inv * g if self._gamma_inv.ndim == 1 else self._gamma_inv @ g)
+
+    def __call__(self, t, q, v):
+        return self.torque(t, q, v, self.state0)
+
+    def lyapunov_with(self, theta, t, q, v, z):
+        """``V = s^T M s / 2 + q~^T Lambda Kd q~ + theta~^T Gamma theta~ / 2`` for the plant
+        parameters ``theta`` (np,) (or the plant's ``Model``), ``M`` the plant's mass matrix
+        (its armature included when estimated). Also for a trajectory: ``t`` (N,), ``q``,
+        ``v`` (N, nv), ``z`` (N, np) give (N,)."""
+        theta = self._parameters("theta", theta)
+        e, _, _, s = self.sliding(t, q, v)
+        nb = 10 * self.model.nbodies
+        kinetic = kinetic_energy_regressor(self.model, q, s) @ theta[:nb]
+        if self.columns["armature"]:
+            arm = theta[nb + self.model.nv * (self.columns["viscous"] + self.columns["coulomb"]):][:self.model.nv]
+            kinetic = kinetic + 0.5 * np.sum(arm * s * s, -1)
+        d = np.asarray(z, dtype=float) - theta
+        return kinetic + np.sum(self.lam * self.kd * e * e, -1) + 0.5 * np.einsum("...i,ij,...j->...", d, self.gamma, d)
+
+    @property
+    def lyapunov(self):
+        """``lyapunov(t, q, v, z)`` with ``theta_true`` (None when it was not given)."""
+        if self.theta_true is None:
+            return None
+        return lambda t, q, v, z: self.lyapunov_with(self.theta_true, t, q, v, z)
