@@ -71,6 +71,11 @@ def _com_batch(ints, body, dofs, Q, check, C, JC, status, nchunk):
             status[s] = com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
 
 
+@kernel
+def _com_single(ints, body, dofs, q, check, c, Jc):
+    return com_one(ints, body, dofs, q, check, c, Jc, workspace(ints.shape[0], dofs.shape[0]))
+
+
 def _run(model, q, check_finite, with_jacobian, what):
     if model.total_mass <= 0:
         raise ValueError(f"{what}: the model has no mass: its centre of mass is undefined")
@@ -80,7 +85,10 @@ def _run(model, q, check_finite, with_jacobian, what):
     B = Q.shape[0]
     C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
     status = np.empty(B, dtype=np.int64)
-    _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, _inputs.chunks(B))
+    if batch == ():  # one state: no parallel launch
+        status[0] = _com_single(k["ints"], k["body"], k["dofs"][(False, False)], Q[0], check_finite, C[0], JC[0])
+    else:
+        _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return batch, C, JC
 

@@ -52,6 +52,11 @@ def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
             status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
 
 
+@kernel
+def _energy_single(ints, body, dofs, grav, q, v, check, out):
+    return energy_one(ints, body, dofs, grav, q, v, check, out, motion_workspace(ints.shape[0], dofs.shape[0]))
+
+
 def _run(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
     k = model._kernel
@@ -59,8 +64,12 @@ def _run(model, check_finite, what, **arrays):
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2)), np.empty(B, dtype=np.int64)
-    _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,
-                  _inputs.chunks(B))
+    if batch == ():  # one state: no parallel launch
+        status[0] = _energy_single(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q[0], V[0],
+                                   check_finite, OUT[0])
+    else:
+        _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,
+                      _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return batch, OUT
 

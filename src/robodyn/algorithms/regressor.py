@@ -129,7 +129,7 @@ def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
         body_regressor(E, vel[i], acc[i], W, t1, t2)
         joint_rows(ints, dofs, liR, lip, i, W, Y, t1)
     extra_rows(params, v, a, 10 * nb, Y)
-    return OK
+    return result_status(check, finite2(Y))
 
 
 @parallel
@@ -139,6 +139,11 @@ def _regressor_batch(ints, body, dofs, params, Q, V, A, check, Y, status, nchunk
         ws = workspace(ints.shape[0], dofs.shape[0])
         for s in range(c * B // nchunk, (c + 1) * B // nchunk):
             status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+
+
+@kernel
+def _regressor_single(ints, body, dofs, params, q, v, a, check, Y):
+    return regressor_one(ints, body, dofs, params, q, v, a, check, Y, workspace(ints.shape[0], dofs.shape[0]))
 
 
 @kernel
@@ -349,8 +354,12 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
     Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
     B = Q.shape[0]
     Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
-    _regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], params, Q, V, A, check_finite, Y, status,
-                     _inputs.chunks(B))
+    if batch == ():  # one state: no parallel launch
+        status[0] = _regressor_single(k["ints"], k["body"], k["dofs"][(False, False)], params, Q[0], V[0], A[0],
+                                      check_finite, Y[0])
+    else:
+        _regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], params, Q, V, A, check_finite, Y, status,
+                         _inputs.chunks(B))
     _inputs.raise_for_status(model, status, x, "regressor")
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
