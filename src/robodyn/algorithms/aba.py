@@ -78,6 +78,64 @@ def invert_block(Dinv, iv, n, G, tol):
     return True
 
 
+@inline
+def joint_inertia(IA_i, dofs, iv, n, U, Dinv, G):
+    """``U_k = IA_i S_k`` (rows ``iv..iv+n`` of ``U``) and ``D^-1 = (S^T IA_i S + armature)^-1``
+    (rows ``iv..iv+n`` of ``Dinv``) for one joint. Returns False when ``D`` is singular: a
+    pivot below ``SINGULAR_RTOL`` times the scale of ``IA_i`` (NaN input propagates)."""
+    scale = 0.0
+    for r in range(6):
+        scale += abs(IA_i[r, r])
+    for k in range(iv, iv + n):
+        matvec6(IA_i, dofs[k, :6], U[k])
+        for j in range(iv, iv + n):
+            d = 0.0
+            for r in range(6):
+                d += dofs[j, r] * U[k, r]
+            Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
+    if n == 1:  # the common case: D is a scalar
+        if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
+            return False
+        Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
+        return True
+    return invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale)
+
+
+@inline
+def articulated_inertia(IA_i, U, Dinv, iv, n, UD, Ia):
+    """``UD = U D^-1`` (6 x n) and the inertia passed to the parent, ``Ia = IA_i - UD U^T``."""
+    for r in range(6):
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += U[iv + k, r] * Dinv[iv + k, j]
+            UD[r, j] = s
+    for r in range(6):
+        for cc in range(6):
+            s = IA_i[r, cc]
+            for j in range(n):
+                s -= UD[r, j] * U[iv + j, cc]
+            Ia[r, cc] = s
+
+
+@inline
+def joint_acceleration(dofs, U, Dinv, u, iv, n, acc_i, qdd, t):
+    """``qdd = D^-1 (u - U^T a_i)`` for one joint, then ``a_i += S qdd`` (``t`` (6,) scratch)."""
+    for k in range(iv, iv + n):
+        s = 0.0
+        for r in range(6):
+            s += U[k, r] * acc_i[r]
+        t[k - iv] = u[k] - s
+    for j in range(iv, iv + n):
+        s = 0.0
+        for k in range(n):
+            s += Dinv[j, k] * t[k]
+        qdd[j] = s
+    for k in range(iv, iv + n):
+        for r in range(6):
+            acc_i[r] += dofs[k, r] * qdd[k]
+
+
 @core
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
@@ -119,40 +177,16 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     # Pass 2
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        scale = 0.0
-        for r in range(6):
-            scale += abs(IA[i, r, r])
         for k in range(iv, iv + n):
-            matvec6(IA[i], dofs[k, :6], U[k])
             s = 0.0
             for r in range(6):
                 s += dofs[k, r] * pA[i, r]
             u[k] = tau[k] - s - friction_torque(dofs, eps, v, k)
-            for j in range(iv, iv + n):
-                d = 0.0
-                for r in range(6):
-                    d += dofs[j, r] * U[k, r]
-                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
-        if n == 1:  # the common case: D is a scalar
-            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:  # (NaN with check_finite=False propagates)
-                return i + 1
-            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
-        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+        if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
-            # UD = U Dinv (6 x n), Ia = IA - UD U^T, pa = pA + Ia c + UD u
-            for r in range(6):
-                for j in range(n):
-                    s = 0.0
-                    for k in range(n):
-                        s += U[iv + k, r] * Dinv[iv + k, j]
-                    UD[r, j] = s
-            for r in range(6):
-                for cc in range(6):
-                    s = IA[i, r, cc]
-                    for j in range(n):
-                        s -= UD[r, j] * U[iv + j, cc]
-                    Ia[r, cc] = s
+            # Ia = IA - U D^-1 U^T, pa = pA + Ia c + U D^-1 u
+            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             matvec6(Ia, c[i], t1)
             for r in range(6):
                 s = pA[i, r] + t1[r]
@@ -175,19 +209,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
             motion_act_inv(liR[i], lip[i], t2, acc[i])
         for r in range(6):
             acc[i, r] += c[i, r]
-        for k in range(iv, iv + n):
-            s = 0.0
-            for r in range(6):
-                s += U[k, r] * acc[i, r]
-            t1[k - iv] = u[k] - s
-        for j in range(iv, iv + n):
-            s = 0.0
-            for k in range(n):
-                s += Dinv[j, k] * t1[k]
-            qdd[j] = s
-        for k in range(iv, iv + n):
-            for r in range(6):
-                acc[i, r] += dofs[k, r] * qdd[k]
+        joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
     return result_status(check, finite(qdd))
 
 

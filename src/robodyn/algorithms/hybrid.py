@@ -33,7 +33,7 @@ from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_mat
                        motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
-from .aba import SINGULAR_RTOL, invert_block, workspace
+from .aba import articulated_inertia, joint_acceleration, joint_inertia, workspace
 from .kinematics import placements, world_placements
 
 
@@ -104,39 +104,15 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
                 for r in range(6):
                     pA[par, r] += t1[r]
             continue
-        scale = 0.0
-        for r in range(6):
-            scale += abs(IA[i, r, r])
         for k in range(iv, iv + n):
-            matvec6(IA[i], dofs[k, :6], U[k])
             s = 0.0
             for r in range(6):
                 s += dofs[k, r] * pA[i, r]
             u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
-            for j in range(iv, iv + n):
-                d = 0.0
-                for r in range(6):
-                    d += dofs[j, r] * U[k, r]
-                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
-        if n == 1:
-            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
-                return i + 1
-            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
-        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+        if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
-            for r in range(6):
-                for j in range(n):
-                    s = 0.0
-                    for k in range(n):
-                        s += U[iv + k, r] * Dinv[iv + k, j]
-                    UD[r, j] = s
-            for r in range(6):
-                for cc in range(6):
-                    s = IA[i, r, cc]
-                    for j in range(n):
-                        s -= UD[r, j] * U[iv + j, cc]
-                    Ia[r, cc] = s
+            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             matvec6(Ia, c[i], t1)
             for r in range(6):
                 s = pA[i, r] + t1[r]
@@ -147,7 +123,7 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
             force_act(liR[i], lip[i], t2, t1)
             for r in range(6):
                 pA[par, r] += t1[r]
-    # Pass 3: accelerations of the free joints, forces of the prescribed ones
+    # Pass 3: accelerations of the joints of unknown acceleration, forces of the others
     for k in range(6):
         t2[k] = 0.0
     t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
@@ -170,20 +146,9 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
                     s += dofs[k, r] * t1[r]
                 tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
             continue
+        joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):
-            s = 0.0
-            for r in range(6):
-                s += U[k, r] * acc[i, r]
-            t1[k - iv] = u[k] - s
-        for j in range(iv, iv + n):
-            s = 0.0
-            for k in range(n):
-                s += Dinv[j, k] * t1[k]
-            qdd[j] = s
-            tau[j] = tau_known[j]
-        for k in range(iv, iv + n):
-            for r in range(6):
-                acc[i, r] += dofs[k, r] * qdd[k]
+            tau[k] = tau_known[k]
     return OK
 
 

@@ -28,10 +28,10 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, kernel, parallel
-from ..spatial import congruence_to_parent, force_act, inertia_matrix, matvec6, motion_act_inv
+from ..spatial import congruence_to_parent, force_act, inertia_matrix, motion_act_inv
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
-from .aba import SINGULAR_RTOL, invert_block
+from .aba import articulated_inertia, joint_inertia
 from .kinematics import placements
 
 
@@ -61,40 +61,16 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
     # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        scale = 0.0
-        for r in range(6):
-            scale += abs(IA[i, r, r])
         for k in range(iv, iv + n):
-            matvec6(IA[i], dofs[k, :6], U[k])
-            for j in range(iv, iv + n):
-                d = 0.0
-                for r in range(6):
-                    d += dofs[j, r] * U[k, r]
-                Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
             for col in range(iv, nv):
                 s = 0.0
                 for r in range(6):
                     s += dofs[k, r] * F[i, r, col]
                 Minv[k, col] = (1.0 if col == k else 0.0) - s
-        if n == 1:
-            if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
-                return i + 1
-            Dinv[iv, 0] = 1.0 / Dinv[iv, 0]
-        elif not invert_block(Dinv, iv, n, G, SINGULAR_RTOL * scale):
+        if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
-            for r in range(6):
-                for j in range(n):
-                    s = 0.0
-                    for k in range(n):
-                        s += U[iv + k, r] * Dinv[iv + k, j]
-                    UD[r, j] = s
-            for r in range(6):
-                for cc in range(6):
-                    s = IA[i, r, cc]
-                    for j in range(n):
-                        s -= UD[r, j] * U[iv + j, cc]
-                    Ia[r, cc] = s
+            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
             for col in range(iv, nv):
                 for r in range(6):
