@@ -1,0 +1,185 @@
+"""Code generation from closed-form expressions: NumPy, Numba and C.
+
+A :class:`Program` is a list of expressions (an output array, row-major) in the joint
+symbols, with ``sin q_k``, ``cos q_k`` as the plain symbols ``s_k``, ``c_k``, reduced by
+common-subexpression elimination (``sympy.cse``) to a sequence of scalar assignments.
+The same program prints as
+
+* a NumPy function vectorised over leading batch dimensions (:func:`numpy_function`),
+* a Numba-compiled function with a loop over the batch (:func:`numba_function`),
+* a C function ``void NAME(const double *q, ..., double *out)`` (:func:`c_function`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+from sympy.codegen.rewriting import create_expand_pow_optimization
+
+_expand_pow = create_expand_pow_optimization(8)
+
+
+def _floats(e: sp.Expr) -> sp.Expr:
+    """Non-integer rationals as double-precision floats (17 significant digits)."""
+    reps = {r: sp.Float(r, 17) for r in e.atoms(sp.Rational) if not r.is_Integer}
+    return e.xreplace(reps) if reps else e
+
+
+@dataclass
+class Program:
+    """``outputs`` (flat, row-major, of ``shape``) after ``assignments``; ``args``: the
+    inputs as ``(name, symbols)``; ``trig``: ``(s_k, c_k, q_k)`` for each revolute joint
+    whose sine or cosine appears."""
+
+    name: str
+    shape: tuple
+    args: list
+    trig: list
+    assignments: list
+    outputs: list
+    doc: str = ""
+
+    @property
+    def arg_names(self) -> list[str]:
+        return [a for a, _ in self.args]
+
+
+def program(name: str, exprs, shape: tuple, args: list, trig: list, doc: str = "") -> Program:
+    """Common-subexpression elimination of ``exprs`` (flat list) into a :class:`Program`."""
+    exprs = [sp.sympify(e) for e in exprs]
+    used = set().union(*(e.free_symbols for e in exprs)) if exprs else set()
+    trig = [(s, c, q) for s, c, q in trig if s in used or c in used]
+    if exprs and any(not e.is_number for e in exprs):
+        assignments, outputs = sp.cse(exprs, symbols=sp.numbered_symbols("x", real=True), order="none")
+    else:
+        assignments, outputs = [], exprs
+    assignments = [(s, _floats(e)) for s, e in assignments]
+    outputs = [_floats(e) for e in outputs]
+    known = {s for _, syms in args for s in syms} | {s for s, _, _ in trig} | {c for _, c, _ in trig}
+    known |= {s for s, _ in assignments}
+    missing = set().union(*(e.free_symbols for e in outputs), *(e.free_symbols for _, e in assignments)) - known
+    if missing:
+        raise ValueError(f"{name}: expressions use symbols that are not inputs: {sorted(map(str, missing))}")
+    return Program(name, tuple(shape), args, trig, assignments, outputs, doc)
+
+
+# -- NumPy ---------------------------------------------------------------------------------
+def numpy_source(prog: Program) -> str:
+    from sympy.printing.numpy import NumPyPrinter
+
+    pr = NumPyPrinter({"fully_qualified_modules": True, "allow_unknown_functions": False})
+    pr._module = "numpy"
+    lines = [f"def {prog.name}({', '.join(prog.arg_names)}):", f'    """{prog.doc}"""']
+    for a, syms in prog.args:
+        lines.append(f"    {a} = _check({a}, {len(syms)}, {a!r})")
+    lines.append(f"    _batch = numpy.broadcast_shapes({', '.join(f'{a}.shape[:-1]' for a in prog.arg_names)})")
+    for a, syms in prog.args:
+        for k, s in enumerate(syms):
+            lines.append(f"    {s} = {a}[..., {k}]")
+    for s, c, q in prog.trig:
+        lines.append(f"    {s} = numpy.sin({q})\n    {c} = numpy.cos({q})")
+    for s, e in prog.assignments:
+        lines.append(f"    {s} = {pr.doprint(e)}")
+    lines.append(f"    _out = numpy.empty(_batch + {prog.shape!r})")
+    for k, e in enumerate(prog.outputs):
+        idx = ", ".join(str(i) for i in np.unravel_index(k, prog.shape)) if prog.shape else ""
+        lines.append(f"    _out[..., {idx}] = {pr.doprint(e)}" if prog.shape else f"    _out[...] = {pr.doprint(e)}")
+    lines.append("    return _out[()]")
+    return "\n".join(lines) + "\n"
+
+
+def _check(x, n, what):
+    x = np.asarray(x, dtype=float)
+    if x.ndim == 0 or x.shape[-1] != n:
+        raise ValueError(f"{what}: expected shape (..., {n}), got {x.shape}")
+    return x
+
+
+def numpy_function(prog: Program):
+    """The NumPy function of ``prog``: arrays ``(..., n)`` in, ``(...,) + shape`` out."""
+    src = numpy_source(prog)
+    ns = {"numpy": np, "_check": _check}
+    exec(compile(src, f"<robodyn.symbolic {prog.name}>", "exec"), ns)
+    f = ns[prog.name]
+    f.source = src
+    return f
+
+
+# -- Numba ---------------------------------------------------------------------------------
+def numba_source(prog: Program) -> str:
+    from sympy.printing.pycode import PythonCodePrinter
+
+    pr = PythonCodePrinter({"fully_qualified_modules": True})
+    ins = [f"{a.upper()}_" for a in prog.arg_names]
+    lines = [f"def {prog.name}_kernel({', '.join(ins)}, OUT):", "    for _b in range(OUT.shape[0]):"]
+    for (a, syms), A in zip(prog.args, ins):
+        lines.append(f"        {a} = {A}[_b if {A}.shape[0] > 1 else 0]")
+        for k, s in enumerate(syms):
+            lines.append(f"        {s} = {a}[{k}]")
+    for s, c, q in prog.trig:
+        lines.append(f"        {s} = math.sin({q})\n        {c} = math.cos({q})")
+    for s, e in prog.assignments:
+        lines.append(f"        {s} = {pr.doprint(e)}")
+    for k, e in enumerate(prog.outputs):
+        lines.append(f"        OUT[_b, {k}] = {pr.doprint(e)}")
+    return "\n".join(lines) + "\n"
+
+
+def numba_function(prog: Program):
+    """The Numba-compiled function of ``prog`` (compiled on first call): same signature and
+    shapes as :func:`numpy_function`, a compiled loop over the batch."""
+    import math
+
+    import numba
+
+    src = numba_source(prog)
+    ns = {"math": math}
+    exec(compile(src, f"<robodyn.symbolic {prog.name} numba>", "exec"), ns)
+    kernel = numba.njit(fastmath=False, error_model="numpy")(ns[f"{prog.name}_kernel"])
+    size = int(np.prod(prog.shape))
+    sizes = [len(s) for _, s in prog.args]
+    names = prog.arg_names
+
+    def f(*xs):
+        if len(xs) != len(names):
+            raise TypeError(f"{prog.name}() takes {len(names)} arguments ({', '.join(names)}), got {len(xs)}")
+        xs = [_check(x, n, a) for x, n, a in zip(xs, sizes, names)]
+        batch = np.broadcast_shapes(*(x.shape[:-1] for x in xs))
+        B = int(np.prod(batch))
+        flat = [np.ascontiguousarray(x.reshape(-1, n)) for x, n in zip(xs, sizes)]
+        if any(x.shape[0] not in (1, B) for x in flat):
+            flat = [np.ascontiguousarray(np.broadcast_to(x, batch + (n,)).reshape(-1, n)) for x, n in zip(xs, sizes)]
+        out = np.empty((B, size))
+        kernel(*flat, out)
+        return out.reshape(batch + prog.shape)
+
+    f.__name__ = prog.name
+    f.__doc__ = prog.doc
+    f.source = src
+    f.kernel = kernel
+    return f
+
+
+# -- C -------------------------------------------------------------------------------------
+def c_prototype(prog: Program, prefix: str) -> str:
+    ins = ", ".join(f"const double *{a}" for a in prog.arg_names)
+    return f"void {prefix}_{prog.name}({ins}, double *out)"
+
+
+def c_function(prog: Program, prefix: str) -> str:
+    """C source of ``prog``: inputs ``const double *`` of the joint and parameter vectors,
+    ``out`` row-major of ``shape``."""
+    lines = [f"/* {prog.doc} */", c_prototype(prog, prefix), "{"]
+    for a, syms in prog.args:
+        for k, s in enumerate(syms):
+            lines.append(f"    const double {s} = {a}[{k}];")
+    for s, c, q in prog.trig:
+        lines.append(f"    const double {s} = sin({q});\n    const double {c} = cos({q});")
+    for s, e in prog.assignments:
+        lines.append(f"    const double {s} = {sp.ccode(_expand_pow(e))};")
+    for k, e in enumerate(prog.outputs):
+        lines.append(f"    out[{k}] = {sp.ccode(_expand_pow(e))};")
+    lines.append("}")
+    return "\n".join(lines) + "\n"
