@@ -118,6 +118,17 @@ class TrigRing:
             return e.xreplace(sub)
         return e.xreplace(self.to_sympy)
 
+    def generator_values(self) -> list:
+        """The value of each generator in generated code: ``s_k``, ``c_k`` as the plain
+        symbols of :meth:`trig_names`, atoms as themselves, other generators unchanged."""
+        sub = {v: k for k, v in self.atom_dummies.items()}
+        for k in range(self.model.nv):
+            if self.revolute[k]:
+                s, c = self.trig_names(k)
+                sub[self._pos_dummies[k]] = s
+                sub[self._cos_dummies[self._cos_number(k)]] = c
+        return [sub.get(g, g) for g in self.ring.symbols]
+
     # -- arithmetic ----------------------------------------------------------------------
     def reduce(self, p):
         """``p`` with every ``c_k^2`` replaced by ``1 - s_k^2`` (canonical form)."""

@@ -191,7 +191,8 @@ class EquationsOfMotion:
         p = self._poly[name]
         flat = [x for row in p for x in row] if name in ("M", "C") else (p if isinstance(p, list) else [p])
         shape = (n, n) if name in ("M", "C") else ((n,) if isinstance(p, list) else ())
-        exprs = [rg.expr(x, "symbols") for x in flat]
+        big = sum(len(x) for x in flat) > codegen.CSE_TERMS
+        exprs = None if big else [rg.expr(x, "symbols") for x in flat]
         inputs, doc = TERMS[name]
         args = [(a, list(getattr(self, a))) for a in inputs]
         if self.parameters:
@@ -200,7 +201,7 @@ class EquationsOfMotion:
         doc = f"{self.model.name}: {doc}; inputs {', '.join(f'{a} (..., {len(s)})' for a, s in args)}"
         if self.parameters:
             doc += f"; params = ({', '.join(s.name for s in self.parameters)})"
-        return codegen.program(name, exprs, shape, args, trig, doc)
+        return codegen.program(name, exprs, shape, args, trig, doc, polys=flat, values=rg.generator_values())
 
     def to_function(self, name: str):
         """NumPy function of a term, vectorised over leading batch dimensions:

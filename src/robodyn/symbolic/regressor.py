@@ -42,13 +42,15 @@ class Regressor:
 
     def program(self) -> codegen.Program:
         rg, n = self._rg, self.model.nv
-        exprs = [rg.expr(p, "symbols") for row in self._Y for p in row]
+        flat = [p for row in self._Y for p in row]
+        exprs = None if sum(len(p) for p in flat) > codegen.CSE_TERMS else [rg.expr(p, "symbols") for p in flat]
         args = [("q", list(self.q)), ("qd", list(self.qd)), ("qdd", list(self.qdd))]
         if self.parameters:
             args.append(("params", list(self.parameters)))
         trig = [(*rg.trig_names(k), self.q[k]) for k in range(n) if rg.revolute[k]]
         doc = f"{self.model.name}: regressor Y(q, qd, qdd), ({n}, {len(self.theta)}), tau = Y theta"
-        return codegen.program("Y", exprs, (n, len(self.theta)), args, trig, doc)
+        return codegen.program("Y", exprs, (n, len(self.theta)), args, trig, doc, polys=flat,
+                               values=rg.generator_values())
 
     def to_function(self):
         """NumPy function ``Y(q, qd, qdd)``, batched: ``(..., n, 10 nbodies)``."""
