@@ -30,6 +30,10 @@ def __getattr__(name):
         value = getattr(importlib.import_module(f".algorithms.{_LAZY[name]}", __name__), name)
         globals()[name] = value
         return value
+    if name == "symbolic":  # imports sympy: only on use
+        import importlib
+
+        return importlib.import_module(".symbolic", __name__)
     if name == "warmup":
         from .warmup import warmup
 
@@ -38,7 +42,7 @@ def __getattr__(name):
 
 
 def __dir__():
-    return sorted(set(globals()) | set(_LAZY) | {"warmup"})
+    return sorted(set(globals()) | set(_LAZY) | {"warmup", "symbolic"})
 
 
 __version__ = "0.1.0"
@@ -48,4 +52,5 @@ __all__ = [
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
+    "symbolic",
 ]

@@ -3,6 +3,7 @@
     robodyn info MODEL          joint table, masses and inertias of a built-in robot or URDF
     robodyn demo [MODEL]        inverse and forward dynamics and the mass matrix at a sample state
     robodyn bench [MODEL]       per-call timings (and the comparison with Pinocchio if installed)
+    robodyn derive MODEL        closed-form M, C, g (sympy), as LaTeX and C code
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 """
@@ -133,6 +134,12 @@ def cmd_bench(args) -> int:
     return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
 
 
+def cmd_derive(args) -> int:
+    from .symbolic.cli import run_derive  # imports sympy
+
+    return run_derive(load_model(args.model, args.floating_base, args.physical), args)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -156,6 +163,13 @@ def main(argv=None) -> int:
     p.add_argument("--batch", type=int, default=10000, help="batch size for the batched timings")
     p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
     p.set_defaults(func=cmd_bench)
+
+    p = sub.add_parser("derive", help="closed-form equations of motion: LaTeX and C code")
+    common(p)
+    p.add_argument("--method", choices=("lagrange", "newton_euler"), default="lagrange")
+    p.add_argument("--latex", metavar="FILE", help="write a LaTeX document of every term")
+    p.add_argument("--c", metavar="DIR", dest="c_dir", help="write C source and header into DIR")
+    p.set_defaults(func=cmd_derive)
 
     args = parser.parse_args(argv)
     try:

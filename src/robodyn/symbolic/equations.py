@@ -49,6 +49,13 @@ TERMS = {
 }
 
 
+def readable_numbers(e: sp.Expr) -> sp.Expr:
+    """Rationals with denominators above 10^6 (the exact values of decimal model data such as
+    ``1/12 * 10`` written as ``0.8333333333333334``) as floats, for display."""
+    reps = {r: sp.Float(r, 16) for r in e.atoms(sp.Rational) if r.q > 10**6}
+    return e.xreplace(reps) if reps else e
+
+
 def christoffel_matrix(rg: TrigRing, M) -> list:
     """``C_ij = sum_k Gamma_ijk qd_k`` with the Christoffel symbols of the first kind of ``M``."""
     n = len(M)
@@ -116,7 +123,7 @@ class EquationsOfMotion:
 
     # -- sympy expressions -------------------------------------------------------------
     def _expr(self, p, trig: str = "functions"):
-        e = self._rg.expr(p, trig)
+        e = readable_numbers(self._rg.expr(p, trig))
         if trig == "functions" and len(p) <= TRIGSIMP_TERMS and len(p) > 1:
             e = sp.trigsimp(e)
         return e

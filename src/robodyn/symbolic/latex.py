@@ -34,7 +34,9 @@ def _names(eom) -> dict:
 
 
 def _tex(eom, e) -> str:
-    return sp.latex(e, symbol_names=_names(eom))
+    from .equations import readable_numbers
+
+    return sp.latex(readable_numbers(e), symbol_names=_names(eom))
 
 
 def _entries(eom, name: str) -> list[tuple[str, sp.Expr]]:
