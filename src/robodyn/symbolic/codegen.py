@@ -75,7 +75,7 @@ def _split_sums(assignments, outputs):
 
 # Above this many terms in all, sympy.cse (slow on big expressions) is replaced by the
 # monomial table of :func:`monomial_cse`.
-CSE_TERMS = 4000
+CSE_TERMS = 1000
 
 
 class Text(str):

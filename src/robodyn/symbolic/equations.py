@@ -34,7 +34,7 @@ from .model import SymbolicModel, from_model
 
 METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
 # Expressions with at most this many terms are passed to sympy's trigsimp.
-TRIGSIMP_TERMS = 12
+TRIGSIMP_TERMS = 6
 
 # term -> (inputs, description)
 TERMS = {
@@ -97,6 +97,7 @@ class EquationsOfMotion:
         self.n = n
         self.q, self.qd, self.qdd = model.q, model.qd, model.qdd
         self.parameters = model.parameters()
+        self._programs = {}
         tau = result["tau"]
         parts = [rg.split(t) for t in tau]
         self._poly = {
@@ -192,6 +193,11 @@ class EquationsOfMotion:
     # -- output ------------------------------------------------------------------------
     def program(self, name: str) -> codegen.Program:
         """The common-subexpression-eliminated :class:`~.codegen.Program` of a term."""
+        if name not in self._programs:
+            self._programs[name] = self._program(name)
+        return self._programs[name]
+
+    def _program(self, name: str) -> codegen.Program:
         if name not in TERMS:
             raise ValueError(f"term must be one of {list(TERMS)}, got {name!r}")
         rg, n = self._rg, self.n
