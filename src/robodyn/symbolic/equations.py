@@ -14,9 +14,10 @@ in ``q = (q1, ...)``, ``qd = (qd1, ...)``, ``qdd = (qdd1, ...)``:
     T, U, L      kinetic energy qd^T M qd / 2, potential energy -sum m_i g . p_ci, T - U
     tau  (n,)    M qdd + C qd + g (as robodyn.rnea without friction)
 
-Friction is not part of these terms. Small expressions are simplified with sympy's
-trigonometric rules (``trigsimp``); larger ones stay in the canonical expanded form (no
-``simplify`` on big expressions, which is what makes other tools take hours). Code
+Friction is not part of these terms. Expressions of up to ``TRIG_TERMS`` terms are rewritten
+with the angle-sum rules (sympy's ``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay
+otherwise in the canonical expanded form (no ``simplify`` or ``trigsimp`` on big
+expressions, which is what makes other tools take hours). Code
 generation (:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) applies
 common-subexpression elimination.
 """
@@ -27,14 +28,15 @@ from functools import cached_property
 from pathlib import Path
 
 import sympy as sp
+from sympy.simplify.fu import TR10i
 
 from . import codegen, lagrange, newton_euler
 from ._ring import TrigRing
 from .model import SymbolicModel, from_model
 
 METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
-# Expressions with at most this many terms are passed to sympy's trigsimp.
-TRIGSIMP_TERMS = 6
+# Expressions with at most this many terms are rewritten with the angle-sum rules.
+TRIG_TERMS = 16
 
 # term -> (inputs, description)
 TERMS = {
@@ -124,10 +126,10 @@ class EquationsOfMotion:
 
     # -- sympy expressions -------------------------------------------------------------
     def _expr(self, p, trig: str = "functions"):
-        e = readable_numbers(self._rg.expr(p, trig))
-        if trig == "functions" and len(p) <= TRIGSIMP_TERMS and len(p) > 1:
-            e = sp.trigsimp(e)
-        return e
+        e = self._rg.expr(p, trig)
+        if trig == "functions" and 1 < len(p) <= TRIG_TERMS:
+            e = TR10i(e)  # c1 c2 - s1 s2 -> cos(q1 + q2), ...
+        return readable_numbers(e)
 
     def _shaped(self, name: str, trig: str = "functions"):
         p = self._poly[name]
