@@ -81,7 +81,7 @@ def compile_c(files: dict, directory, name):
     assert cc, "a C compiler (cc or gcc) is required to test the generated C code"
     src = [str(directory / k) for k in files if k.endswith(".c")]
     lib = directory / f"lib{name}.so"
-    subprocess.run([cc, "-O1", "-shared", "-fPIC", "-o", str(lib), *src, "-lm"], check=True, capture_output=True)
+    subprocess.run([cc, "-O0", "-shared", "-fPIC", "-o", str(lib), *src, "-lm"], check=True, capture_output=True)
     return ctypes.CDLL(str(lib))
 
 

@@ -52,5 +52,6 @@ __all__ = [
     "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
-    "symbolic",
 ]
+# ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
+# ``__all__`` so that ``from robodyn import *`` stays light.

@@ -12,7 +12,8 @@ polynomial over the rationals in these generators:
 Products are reduced with ``c_k^2 = 1 - s_k^2`` (so each ``c_k`` has degree 0 or 1). The
 monomials ``s^a`` and ``s^a c`` are a basis of the polynomials in ``sin q, cos q``, so this
 form is canonical: two expressions are equal as functions of ``q`` exactly when their
-reduced polynomials are equal, and no ``simplify`` is ever needed. sympy's ring arithmetic
+reduced polynomials are equal, and no ``simplify`` is ever needed (for the joint angles;
+opaque parameter generators such as ``cos(alpha1)`` and ``sin(alpha1)`` are independent). sympy's ring arithmetic
 (sparse dictionaries of exponent tuples) is much faster than arithmetic on expression trees,
 which is what makes 6- and 7-dof derivations take seconds instead of hours.
 """
