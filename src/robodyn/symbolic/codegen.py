@@ -242,10 +242,14 @@ def numba_function(prog: Program):
 
     import numba
 
+    from .._jit import FASTMATH
+
     src = numba_source(prog)
     ns = {"math": math}
     exec(compile(src, f"<robodyn.symbolic {prog.name} numba>", "exec"), ns)
-    kernel = numba.njit(fastmath=False, error_model="numpy")(ns[f"{prog.name}_kernel"])
+    # the core kernels' settings: fused multiply-add and reassociation (the sums of thousands
+    # of terms vectorise), NaN/Inf semantics kept
+    kernel = numba.njit(error_model="numpy", fastmath=FASTMATH, nogil=True)(ns[f"{prog.name}_kernel"])
     size = int(np.prod(prog.shape))
     sizes = [len(s) for _, s in prog.args]
     names = prog.arg_names
