@@ -165,6 +165,14 @@ def _public_calls(model, q, v, a):
         "jacobian_dot_times_v": lambda: rd.jacobian_dot_times_v(model, q, v, body),
         "forward_kinematics": lambda: rd.forward_kinematics(model, q),
         "frame_pose": lambda: rd.frame_pose(model, q, body),
+        "hybrid_dynamics": lambda: rd.hybrid_dynamics(model, q, v, a, a, np.arange(model.nv) >= 6),
+        "inverse_mass_matrix": lambda: rd.inverse_mass_matrix(model, q),
+        "regressor": lambda: rd.regressor(model, q, v, a),
+        "slotine_li_regressor": lambda: rd.slotine_li_regressor(model, q, v, v, a),
+        "kinetic_energy_regressor": lambda: rd.kinetic_energy_regressor(model, q, v),
+        "potential_energy_regressor": lambda: rd.potential_energy_regressor(model, q),
+        "integrate": lambda: rd.integrate(model, q, v),
+        "task_space_inertia": lambda: rd.task_space_inertia(model, q, body),
     }
 
 

@@ -30,7 +30,7 @@ _LAZY = {
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
-              "plots": None}
+              "plots": None, "identification": None, "symbolic": None}
 
 
 def __getattr__(name):
@@ -72,3 +72,5 @@ __all__ = [
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
     "slotine_li_regressor",
 ]
+# ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
+# ``__all__`` so that ``from robodyn import *`` stays light.

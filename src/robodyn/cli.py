@@ -7,6 +7,7 @@
     robodyn torques MODEL CSV   joint forces of a trajectory: inertial, Coriolis, gravity
     robodyn excite MODEL ...    excitation trajectory for identification (robodyn.identification.cli)
     robodyn identify MODEL CSV  identified parameters, URDF and report (robodyn.identification.cli)
+    robodyn derive MODEL        closed-form M, C, g (sympy), as LaTeX and C code
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 """
@@ -137,6 +138,12 @@ def cmd_bench(args) -> int:
     return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
 
 
+def cmd_derive(args) -> int:
+    from .symbolic.cli import run_derive  # imports sympy
+
+    return run_derive(load_model(args.model, args.floating_base, args.physical), args)
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics.")
     sub = parser.add_subparsers(dest="command", required=True)
@@ -165,6 +172,13 @@ def main(argv=None) -> int:
 
     add_simulation_commands(sub, common)
     add_identification_commands(sub, common)
+
+    p = sub.add_parser("derive", help="closed-form equations of motion: LaTeX and C code")
+    common(p)
+    p.add_argument("--method", choices=("lagrange", "newton_euler"), default="lagrange")
+    p.add_argument("--latex", metavar="FILE", help="write a LaTeX document of every term")
+    p.add_argument("--c", metavar="DIR", dest="c_dir", help="write C source and header into DIR")
+    p.set_defaults(func=cmd_derive)
 
     args = parser.parse_args(argv)
     try:

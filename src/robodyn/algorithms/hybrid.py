@@ -32,7 +32,7 @@ from ..joint_kernels import friction_torque
 from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul, matvec6,
                        motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status
 from .aba import articulated_inertia, joint_acceleration, joint_inertia, workspace
 from .kinematics import placements, world_placements
 
@@ -149,7 +149,7 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
         joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):
             tau[k] = tau_known[k]
-    return OK
+    return result_status(check, finite(qdd) and finite(tau))
 
 
 @parallel

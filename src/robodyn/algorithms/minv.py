@@ -30,7 +30,7 @@ from numba import prange
 from .._jit import core, kernel, parallel
 from ..spatial import congruence_to_parent, force_act, inertia_matrix, motion_act_inv
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of
+from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
 from .aba import articulated_inertia, joint_inertia
 from .kinematics import placements
 
@@ -108,7 +108,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
     for k in range(nv):
         for col in range(k + 1, nv):
             Minv[col, k] = Minv[k, col]
-    return OK
+    return result_status(check, finite2(Minv))
 
 
 @parallel

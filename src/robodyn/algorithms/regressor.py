@@ -268,7 +268,7 @@ def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
         out[1, 10 * i] = -(grav[0] * op[i, 0] + grav[1] * op[i, 1] + grav[2] * op[i, 2])
         for c in range(3):  # -g . R h = -(R^T g) . h
             out[1, 10 * i + 1 + c] = -(grav[0] * oR[i, 0, c] + grav[1] * oR[i, 1, c] + grav[2] * oR[i, 2, c])
-    return OK
+    return result_status(check, finite2(out))
 
 
 @parallel

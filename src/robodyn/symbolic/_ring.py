@@ -1,0 +1,209 @@
+"""Exact trigonometric polynomials for the derivations (sympy's sparse polynomial rings).
+
+Every quantity of a derivation (placements, velocities, forces, M, C, g, energies) is a
+polynomial over the rationals in these generators:
+
+* ``s_k, c_k`` (``sin q_k``, ``cos q_k``) for a revolute joint ``k``, ``x_k`` (``q_k``) for
+  a prismatic one;
+* ``qd_k`` and ``qdd_k``;
+* the model's parameters: its free symbols, and every non-polynomial piece of its entries
+  (``cos(alpha1)``, ``sqrt(2)``, ``pi``) as an opaque generator.
+
+Products are reduced with ``c_k^2 = 1 - s_k^2`` (so each ``c_k`` has degree 0 or 1). The
+monomials ``s^a`` and ``s^a c`` are a basis of the polynomials in ``sin q, cos q``, so this
+form is canonical: two expressions are equal as functions of ``q`` exactly when their
+reduced polynomials are equal, and no ``simplify`` is ever needed (for the joint angles;
+opaque parameter generators such as ``cos(alpha1)`` and ``sin(alpha1)`` are independent). sympy's ring arithmetic
+(sparse dictionaries of exponent tuples) is much faster than arithmetic on expression trees,
+which is what makes 6- and 7-dof derivations take seconds instead of hours.
+"""
+
+from __future__ import annotations
+
+from math import comb
+
+import sympy as sp
+from sympy import QQ
+from sympy.polys.rings import PolyRing
+
+from .model import SymbolicModel
+
+
+def _nonpolynomial_atoms(e: sp.Expr) -> set:
+    """Maximal sub-expressions of ``e`` that are not polynomial in its symbols: functions,
+    constants such as ``pi``, and powers with non-natural exponents (``sqrt(2)``, ``1/m``)."""
+    out = set()
+    walk = sp.preorder_traversal(e)
+    for a in walk:
+        if isinstance(a, (sp.Function, sp.NumberSymbol)) or (
+                isinstance(a, sp.Pow) and not (a.exp.is_Integer and a.exp > 0)):
+            out.add(a)
+            walk.skip()
+    return out
+
+
+class TrigRing:
+    """The polynomial ring of a model's derivation, with trigonometric reduction,
+    differentiation along ``q`` and conversion to and from sympy expressions."""
+
+    def __init__(self, model: SymbolicModel):
+        n = model.nv
+        self.model = model
+        self.revolute = [t == "revolute" for t in model.joint_type]
+        pos = [sp.Dummy(f"s{k + 1}") if r else model.q[k] for k, r in enumerate(self.revolute)]
+        cos = [sp.Dummy(f"c{k + 1}") for k, r in enumerate(self.revolute) if r]
+        exprs = list(model.gravity) + [*model.armature]
+        for i in range(model.nbodies):
+            exprs += [*model.axis[i], *model.R_tree[i], *model.p_tree[i], *model.inertia[i]]
+        atoms = set()
+        for e in exprs:
+            atoms |= _nonpolynomial_atoms(e)
+        self.atom_dummies = {a: sp.Dummy(f"a{j}") for j, a in enumerate(sorted(atoms, key=sp.default_sort_key))}
+        params = sorted(set().union(*(e.free_symbols for e in exprs)) - set(model.q), key=lambda s: s.name)
+        gens = pos + cos + list(model.qd) + list(model.qdd) + params + list(self.atom_dummies.values())
+        self.ring = PolyRing(gens, QQ, "lex")
+        g = self.ring.gens
+        self.pos = g[:n]
+        ci = iter(g[n:n + len(cos)])
+        self.cos = [next(ci) if r else None for r in self.revolute]
+        self.qd = g[n + len(cos):2 * n + len(cos)]
+        self.qdd = g[2 * n + len(cos):3 * n + len(cos)]
+        index = {x: j for j, x in enumerate(g)}
+        # (s index, c index) of each revolute joint, for the reduction c^2 = 1 - s^2
+        self.pairs = [(index[self.pos[k]], index[self.cos[k]]) for k in range(n) if self.revolute[k]]
+        self.qd_index = [index[x] for x in self.qd]
+        self.qdd_index = [index[x] for x in self.qdd]
+        # back to sympy: s_k -> sin(q_k), c_k -> cos(q_k), atoms back to themselves
+        self.trig_symbols = {}
+        self.to_sympy = {v: k for k, v in self.atom_dummies.items()}
+        for k in range(n):
+            if self.revolute[k]:
+                self.to_sympy[pos[k]] = sp.sin(model.q[k])
+                self.to_sympy[cos[self._cos_number(k)]] = sp.cos(model.q[k])
+        self._cos_dummies = cos
+        self._pos_dummies = pos
+        self.zero, self.one = self.ring.zero, self.ring.one
+
+    def _cos_number(self, k: int) -> int:
+        return sum(self.revolute[:k])
+
+    # -- conversion ----------------------------------------------------------------------
+    def const(self, e) -> "PolyElement":  # noqa: F821
+        """A model expression (no joint symbols except prismatic ``q_k``) in the ring."""
+        e = sp.sympify(e)
+        if self.atom_dummies:
+            e = e.xreplace(self.atom_dummies)
+        return self.ring.from_expr(e) if e.free_symbols else self.ring(QQ.convert(e) if e.is_Rational else e)
+
+    def vec(self, v) -> list:
+        return [self.const(x) for x in v]
+
+    def mat(self, m) -> list:
+        return [[self.const(m[r, c]) for c in range(3)] for r in range(3)]
+
+    def trig_names(self, k: int) -> tuple[sp.Symbol, sp.Symbol]:
+        """Plain symbols ``s{k+1}``, ``c{k+1}`` for generated code."""
+        return sp.Symbol(f"s{k + 1}", real=True), sp.Symbol(f"c{k + 1}", real=True)
+
+    def expr(self, p, trig: str = "functions") -> sp.Expr:
+        """``p`` as a sympy expression: ``trig="functions"`` writes ``sin(q1)``, ``cos(q1)``;
+        ``trig="symbols"`` writes the plain symbols ``s1``, ``c1`` (for generated code)."""
+        e = p.as_expr()
+        if trig == "symbols":
+            sub = {v: k for k, v in self.atom_dummies.items()}
+            for k in range(self.model.nv):
+                if self.revolute[k]:
+                    s, c = self.trig_names(k)
+                    sub[self._pos_dummies[k]] = s
+                    sub[self._cos_dummies[self._cos_number(k)]] = c
+            return e.xreplace(sub)
+        return e.xreplace(self.to_sympy)
+
+    def generator_values(self) -> list:
+        """The value of each generator in generated code: ``s_k``, ``c_k`` as the plain
+        symbols of :meth:`trig_names`, atoms as themselves, other generators unchanged."""
+        sub = {v: k for k, v in self.atom_dummies.items()}
+        for k in range(self.model.nv):
+            if self.revolute[k]:
+                s, c = self.trig_names(k)
+                sub[self._pos_dummies[k]] = s
+                sub[self._cos_dummies[self._cos_number(k)]] = c
+        return [sub.get(g, g) for g in self.ring.symbols]
+
+    # -- arithmetic ----------------------------------------------------------------------
+    def reduce(self, p):
+        """``p`` with every ``c_k^2`` replaced by ``1 - s_k^2`` (canonical form)."""
+        pairs = self.pairs
+        if not any(m[ci] >= 2 for m in p for _, ci in pairs):
+            return p
+        out = {}
+        for mon, coef in p.items():
+            terms = [(mon, coef)]
+            for si, ci in pairs:
+                if mon[ci] < 2:
+                    continue
+                new = []
+                for m, cf in terms:
+                    k, r = divmod(m[ci], 2)
+                    for j in range(k + 1):
+                        mm = list(m)
+                        mm[ci] = r
+                        mm[si] += 2 * j
+                        new.append((tuple(mm), cf * (comb(k, j) * (-1) ** j)))
+                terms = new
+            for m, cf in terms:
+                out[m] = out.get(m, 0) + cf
+        res = self.ring.zero.copy()
+        for m, cf in out.items():
+            if cf:
+                res[m] = cf
+        return res
+
+    def dq(self, p, k: int):
+        """``dp/dq_k``: ``c_k dp/ds_k - s_k dp/dc_k`` (revolute) or ``dp/dx_k`` (prismatic)."""
+        if not self.revolute[k]:
+            return p.diff(self.pos[k])
+        s, c = self.pos[k], self.cos[k]
+        return self.reduce(p.diff(s) * c - p.diff(c) * s)
+
+    def ddt(self, p):
+        """Time derivative along the motion: ``sum_k dp/dq_k qd_k + dp/dqd_k qdd_k``."""
+        out = self.zero
+        for k in range(self.model.nv):
+            out = out + self.dq(p, k) * self.qd[k] + p.diff(self.qd[k]) * self.qdd[k]
+        return out
+
+    def split(self, p):
+        """Terms of ``p`` by their degree in ``qd`` and ``qdd``: ``{(deg qd, deg qdd): poly}``."""
+        parts = {}
+        for m, cf in p.items():
+            key = (sum(m[j] for j in self.qd_index), sum(m[j] for j in self.qdd_index))
+            parts.setdefault(key, {})[m] = cf
+        out = {}
+        for key, d in parts.items():
+            e = self.ring.zero.copy()
+            e.update(d)
+            out[key] = e
+        return out
+
+    def coefficient(self, p, j: int, which: str = "qdd"):
+        """The coefficient of ``qdd_j`` (or ``qd_j``) in ``p``, which is linear in it."""
+        return p.diff(self.qdd[j] if which == "qdd" else self.qd[j])
+
+    # -- vectors -------------------------------------------------------------------------
+    def matvec(self, R, v):
+        return [self.reduce(R[r][0] * v[0] + R[r][1] * v[1] + R[r][2] * v[2]) for r in range(3)]
+
+    def matTvec(self, R, v):
+        return [self.reduce(R[0][r] * v[0] + R[1][r] * v[1] + R[2][r] * v[2]) for r in range(3)]
+
+    def matmul(self, A, B):
+        return [[self.reduce(sum((A[r][k] * B[k][c] for k in range(3)), self.zero)) for c in range(3)]
+                for r in range(3)]
+
+    @staticmethod
+    def cross(a, b):
+        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+    def dot(self, a, b):
+        return self.reduce(sum((x * y for x, y in zip(a, b)), self.zero))

@@ -1,0 +1,101 @@
+"""Spatial algebra on ring polynomials, with the numeric core's conventions.
+
+Motion vectors ``[v; w]`` (linear first), force vectors ``[f; n]``, placements ``(R, p)`` of
+a child frame in its parent, inertias as the 10 parameters ``[m, h, I_o]`` about the frame
+origin (``h = m c``), exactly as in :mod:`robodyn.spatial`. Reference: R. Featherstone,
+*Rigid Body Dynamics Algorithms*, Springer 2008, chapter 2 (halves of the vectors swapped).
+"""
+
+from __future__ import annotations
+
+from ._ring import TrigRing
+
+
+def joint_placement(rg: TrigRing, i: int):
+    """``(R, p)`` of body ``i`` in its parent: ``X_tree * X_J(q_i)``.
+
+    Revolute about the unit axis ``a``: ``R = R_tree (a a^T + c (1 - a a^T) + s [a]x)``
+    (Rodrigues), ``p = p_tree``; prismatic: ``R = R_tree``, ``p = p_tree + R_tree a x``.
+    """
+    m = rg.model
+    Rt, pt, a = rg.mat(m.R_tree[i]), rg.vec(m.p_tree[i]), rg.vec(m.axis[i])
+    if not rg.revolute[i]:
+        d = rg.matvec(Rt, a)
+        return Rt, [pt[r] + d[r] * rg.pos[i] for r in range(3)]
+    s, c = rg.pos[i], rg.cos[i]
+    ax = [[rg.zero, -a[2], a[1]], [a[2], rg.zero, -a[0]], [-a[1], a[0], rg.zero]]
+    rot = [[a[r] * a[k] * (1 - c) + (c if r == k else rg.zero) + s * ax[r][k] for k in range(3)] for r in range(3)]
+    return rg.matmul(Rt, rot), pt
+
+
+def motion_subspace(rg: TrigRing, i: int) -> list:
+    """``S_i`` (6,) in body ``i``'s frame."""
+    a = rg.vec(rg.model.axis[i])
+    z = [rg.zero] * 3
+    return z + a if rg.revolute[i] else a + z
+
+
+def motion_act_inv(rg: TrigRing, R, p, m) -> list:
+    """Motion vector from parent to child coordinates: ``[R^T (v - p x w); R^T w]``."""
+    w = m[3:]
+    u = [m[r] - x for r, x in enumerate(rg.cross(p, w))]
+    return rg.matTvec(R, u) + rg.matTvec(R, w)
+
+
+def force_act(rg: TrigRing, R, p, f) -> list:
+    """Force vector from child to parent coordinates: ``[R f; R n + p x R f]``."""
+    Rf = rg.matvec(R, f[:3])
+    Rn = rg.matvec(R, f[3:])
+    return Rf + [rg.reduce(Rn[r] + x) for r, x in enumerate(rg.cross(p, Rf))]
+
+
+def motion_cross(rg: TrigRing, V, m) -> list:
+    """``V x m`` for motion vectors ``V = [v; w]``, ``m = [u; o]``: ``[w x u + v x o; w x o]``."""
+    v, w, u, o = V[:3], V[3:], m[:3], m[3:]
+    a, b, c = rg.cross(w, u), rg.cross(v, o), rg.cross(w, o)
+    return [rg.reduce(a[r] + b[r]) for r in range(3)] + [rg.reduce(x) for x in c]
+
+
+def force_cross(rg: TrigRing, V, f) -> list:
+    """``V x* f`` for a motion ``V = [v; w]`` and a force ``f = [g; n]``: ``[w x g; w x n + v x g]``."""
+    v, w, g, n = V[:3], V[3:], f[:3], f[3:]
+    a, b, c = rg.cross(w, g), rg.cross(w, n), rg.cross(v, g)
+    return [rg.reduce(x) for x in a] + [rg.reduce(b[r] + c[r]) for r in range(3)]
+
+
+def inertia_mul(rg: TrigRing, theta, V) -> list:
+    """``I V`` for the inertia ``theta = [m, h, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` about the origin:
+    ``[m v + w x h; I_o w + h x v]``."""
+    m, h = theta[0], theta[1:4]
+    Io = [[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]]
+    v, w = V[:3], V[3:]
+    wh, hv = rg.cross(w, h), rg.cross(h, v)
+    f = [rg.reduce(m * v[r] + wh[r]) for r in range(3)]
+    n = [rg.reduce(Io[r][0] * w[0] + Io[r][1] * w[1] + Io[r][2] * w[2] + hv[r]) for r in range(3)]
+    return f + n
+
+
+def world_poses(rg: TrigRing) -> list:
+    """``(oR_i, op_i)`` of every body in the world frame."""
+    out = []
+    for i in range(rg.model.nbodies):
+        R, p = joint_placement(rg, i)
+        par = rg.model.parent[i]
+        if par < 0:
+            out.append((R, p))
+        else:
+            oR, op = out[par]
+            q = rg.matvec(oR, p)
+            out.append((rg.matmul(oR, R), [op[r] + q[r] for r in range(3)]))
+    return out
+
+
+def potential_energy(rg: TrigRing, poses) -> "PolyElement":  # noqa: F821
+    """``U = -sum_i g . (m_i op_i + oR_i h_i)``: gravity ``g`` in the world frame."""
+    g = rg.vec(rg.model.gravity)
+    U = rg.zero
+    for i, (oR, op) in enumerate(poses):
+        th = [rg.const(t) for t in rg.model.inertia[i]]
+        Rh = rg.matvec(oR, th[1:4])
+        U = U - sum((g[r] * (th[0] * op[r] + Rh[r]) for r in range(3)), rg.zero)
+    return rg.reduce(U)

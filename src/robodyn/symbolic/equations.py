@@ -1,0 +1,289 @@
+"""Closed-form equations of motion ``M(q) qdd + C(q, qd) qd + g(q) = tau``.
+
+:func:`equations_of_motion` derives them by the energy route (:mod:`.lagrange`) or the
+recursive Newton-Euler route (:mod:`.newton_euler`) in exact trigonometric polynomials
+(:mod:`._ring`), and returns :class:`EquationsOfMotion` with the terms as sympy expressions
+in ``q = (q1, ...)``, ``qd = (qd1, ...)``, ``qdd = (qdd1, ...)``:
+
+    M    (n, n)  mass matrix, with the joints' armature on the diagonal
+    C    (n, n)  Christoffel matrix C_ij = sum_k Gamma_ijk qd_k,
+                 Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2, so Mdot - 2C is
+                 skew-symmetric (as robodyn.coriolis_matrix)
+    C_qd (n,)    C qd, the Coriolis and centrifugal forces
+    g    (n,)    gravity forces dU/dq (as robodyn.gravity)
+    T, U, L      kinetic energy qd^T M qd / 2, potential energy -sum m_i g . p_ci, T - U
+    tau  (n,)    M qdd + C qd + g (as robodyn.rnea without friction)
+
+Friction is not part of these terms. Expressions of up to ``TRIG_TERMS`` terms are rewritten
+with the angle-sum rules (sympy's ``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay
+otherwise in the canonical expanded form (no ``simplify`` or ``trigsimp`` on big
+expressions, which is what makes other tools take hours). Code
+generation (:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) applies
+common-subexpression elimination.
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+from pathlib import Path
+
+import sympy as sp
+from sympy.simplify.fu import TR10i
+
+from . import codegen, lagrange, newton_euler
+from ._ring import TrigRing
+from .model import SymbolicModel, from_model
+
+METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
+# Expressions with at most this many terms are rewritten with the angle-sum rules.
+TRIG_TERMS = 16
+
+# term -> (inputs, description)
+TERMS = {
+    "M": (("q",), "mass matrix M(q), (n, n)"),
+    "C": (("q", "qd"), "Christoffel matrix C(q, qd), (n, n): C qd Coriolis forces, Mdot - 2C skew-symmetric"),
+    "C_qd": (("q", "qd"), "Coriolis and centrifugal forces C(q, qd) qd, (n,)"),
+    "g": (("q",), "gravity forces g(q) = dU/dq, (n,)"),
+    "tau": (("q", "qd", "qdd"), "joint forces M qdd + C qd + g, (n,)"),
+    "T": (("q", "qd"), "kinetic energy qd^T M qd / 2"),
+    "U": (("q",), "potential energy -sum m_i g . p_ci"),
+    "L": (("q", "qd"), "Lagrangian T - U"),
+}
+
+
+def readable_numbers(e: sp.Expr) -> sp.Expr:
+    """Rationals with denominators above 10^6 (the exact values of decimal model data such as
+    ``1/12 * 10`` written as ``0.8333333333333334``) as floats, for display."""
+    reps = {r: sp.Float(r, 16) for r in e.atoms(sp.Rational) if r.q > 10**6}
+    return e.xreplace(reps) if reps else e
+
+
+def christoffel_matrix(rg: TrigRing, M) -> list:
+    """``C_ij = sum_k Gamma_ijk qd_k`` with the Christoffel symbols of the first kind of ``M``."""
+    n = len(M)
+    dM = [[[rg.dq(M[i][j], k) for k in range(n)] for j in range(n)] for i in range(n)]
+    return [[sum(((dM[i][j][k] + dM[i][k][j] - dM[j][k][i]) * rg.qd[k] for k in range(n)), rg.zero) / 2
+             for j in range(n)] for i in range(n)]
+
+
+def christoffel_from_quadratic(rg: TrigRing, quad, n: int) -> list:
+    """``C`` from the quadratic part ``sum_jk Gamma_ijk qd_j qd_k`` of each ``tau_i``, with
+    ``Gamma_ijk`` symmetric in ``j, k`` (a ``qd_j qd_k`` term, ``j != k``, holds ``2 Gamma_ijk``)."""
+    C = [[rg.zero.copy() for _ in range(n)] for _ in range(n)]
+    for i in range(n):
+        for mon, cf in quad[i].items():
+            js = [j for j in range(n) if mon[rg.qd_index[j]]]
+            if len(js) == 1:  # qd_j^2: Gamma_ijj
+                j = js[0]
+                m = list(mon)
+                m[rg.qd_index[j]] -= 1
+                C[i][j] += rg.ring.term_new(tuple(m), cf)
+            else:  # qd_j qd_k: Gamma_ijk = Gamma_ikj = cf / 2
+                j, k = js
+                for a, b in ((j, k), (k, j)):
+                    m = list(mon)
+                    m[rg.qd_index[a]] -= 1  # C_ia = sum_b Gamma_iab qd_b
+                    C[i][a] += rg.ring.term_new(tuple(m), cf / 2)
+    return C
+
+
+class EquationsOfMotion:
+    """The closed-form terms of one model (module docstring); ``method`` says how they
+    were derived. Terms are computed once, on first access."""
+
+    def __init__(self, model: SymbolicModel, method: str, rg: TrigRing, result: dict):
+        self.model = model
+        self.method = method
+        self._rg = rg
+        n = model.nv
+        self.n = n
+        self.q, self.qd, self.qdd = model.q, model.qd, model.qdd
+        self.parameters = model.parameters()
+        self._programs = {}
+        tau = result["tau"]
+        parts = [rg.split(t) for t in tau]
+        self._poly = {
+            "tau": tau,
+            "M": [[rg.coefficient(tau[i], j) for j in range(n)] for i in range(n)],
+            "g": [p.get((0, 0), rg.zero) for p in parts],
+            "C_qd": [p.get((2, 0), rg.zero) for p in parts],
+            "T": result["T"],
+            "U": result["U"],
+        }
+        self._poly["L"] = result["T"] - result["U"]
+        if method == "newton_euler":
+            self._poly["C"] = christoffel_from_quadratic(rg, self._poly["C_qd"], n)
+        else:
+            self._poly["C"] = christoffel_matrix(rg, self._poly["M"])
+        extra = set(parts[0]) if n else set()
+        for p in parts:
+            extra |= set(p)
+        if extra - {(0, 0), (2, 0), (0, 1)}:
+            raise AssertionError(f"tau has terms of degrees {sorted(extra)} in (qd, qdd)")
+
+    def __repr__(self) -> str:
+        return f"EquationsOfMotion({self.model.name!r}, method={self.method!r}, n={self.n})"
+
+    # -- sympy expressions -------------------------------------------------------------
+    def _expr(self, p, trig: str = "functions"):
+        e = self._rg.expr(p, trig)
+        if trig == "functions" and 1 < len(p) <= TRIG_TERMS:
+            e = TR10i(e)  # c1 c2 - s1 s2 -> cos(q1 + q2), ...
+        return readable_numbers(e)
+
+    def _shaped(self, name: str, trig: str = "functions"):
+        p = self._poly[name]
+        if name in ("M", "C"):
+            return sp.Matrix(self.n, self.n, [self._expr(x, trig) for row in p for x in row])
+        if name in ("g", "C_qd", "tau"):
+            return sp.Matrix(self.n, 1, [self._expr(x, trig) for x in p])
+        return self._expr(p, trig)
+
+    @cached_property
+    def M(self) -> sp.Matrix:
+        """Mass matrix ``M(q)`` (n x n), armature included."""
+        return self._shaped("M")
+
+    @cached_property
+    def C(self) -> sp.Matrix:
+        """Christoffel matrix ``C(q, qd)`` (n x n), ``Mdot - 2C`` skew-symmetric."""
+        return self._shaped("C")
+
+    @cached_property
+    def C_qd(self) -> sp.Matrix:
+        """Coriolis and centrifugal forces ``C(q, qd) qd`` (n x 1)."""
+        return self._shaped("C_qd")
+
+    @cached_property
+    def g(self) -> sp.Matrix:
+        """Gravity forces ``g(q) = dU/dq`` (n x 1)."""
+        return self._shaped("g")
+
+    @cached_property
+    def tau(self) -> sp.Matrix:
+        """Joint forces ``M qdd + C qd + g`` (n x 1)."""
+        return self._shaped("tau")
+
+    @cached_property
+    def T(self) -> sp.Expr:
+        """Kinetic energy ``qd^T M qd / 2``."""
+        return self._shaped("T")
+
+    @cached_property
+    def U(self) -> sp.Expr:
+        """Potential energy ``-sum_i m_i g . p_ci``."""
+        return self._shaped("U")
+
+    @cached_property
+    def L(self) -> sp.Expr:
+        """Lagrangian ``T - U``."""
+        return self._shaped("L")
+
+    def term(self, name: str):
+        """A term by name: ``"M"``, ``"C"``, ``"C_qd"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""
+        if name not in TERMS:
+            raise ValueError(f"term must be one of {list(TERMS)}, got {name!r}")
+        return getattr(self, name)
+
+    def equals(self, other: "EquationsOfMotion", name: str) -> bool:
+        """Exact equality of a term with the same term of ``other`` (same model), by the
+        canonical polynomial form: no simplification heuristics involved."""
+        a, b = self._poly[name], other._poly[name]
+        flat = lambda x: [e for row in x for e in row] if isinstance(x, list) and x and isinstance(x[0], list) else (x if isinstance(x, list) else [x])  # noqa: E731
+        return all(self._rg.expr(u, "symbols") - other._rg.expr(v, "symbols") == 0 for u, v in zip(flat(a), flat(b)))
+
+    # -- output ------------------------------------------------------------------------
+    def program(self, name: str) -> codegen.Program:
+        """The common-subexpression-eliminated :class:`~.codegen.Program` of a term."""
+        if name not in self._programs:
+            self._programs[name] = self._program(name)
+        return self._programs[name]
+
+    def _program(self, name: str) -> codegen.Program:
+        if name not in TERMS:
+            raise ValueError(f"term must be one of {list(TERMS)}, got {name!r}")
+        rg, n = self._rg, self.n
+        p = self._poly[name]
+        flat = [x for row in p for x in row] if name in ("M", "C") else (p if isinstance(p, list) else [p])
+        shape = (n, n) if name in ("M", "C") else ((n,) if isinstance(p, list) else ())
+        big = sum(len(x) for x in flat) > codegen.CSE_TERMS
+        exprs = None if big else [rg.expr(x, "symbols") for x in flat]
+        inputs, doc = TERMS[name]
+        args = [(a, list(getattr(self, a))) for a in inputs]
+        if self.parameters:
+            args.append(("params", list(self.parameters)))
+        trig = [(*rg.trig_names(k), self.q[k]) for k in range(n) if rg.revolute[k]]
+        doc = f"{self.model.name}: {doc}; inputs {', '.join(f'{a} (..., {len(s)})' for a, s in args)}"
+        if self.parameters:
+            doc += f"; params = ({', '.join(s.name for s in self.parameters)})"
+        return codegen.program(name, exprs, shape, args, trig, doc, polys=flat, values=rg.generator_values())
+
+    def to_function(self, name: str):
+        """NumPy function of a term, vectorised over leading batch dimensions:
+        ``M(q)``, ``C(q, qd)``, ``g(q)``, ``tau(q, qd, qdd)``, ... with arrays ``(..., n)``
+        (and ``params (..., len(parameters))`` when the model has free symbols)."""
+        return codegen.numpy_function(self.program(name))
+
+    def to_numba(self, name: str):
+        """Numba-compiled function of a term (same signature as :meth:`to_function`)."""
+        return codegen.numba_function(self.program(name))
+
+    def c_prefix(self) -> str:
+        return "".join(ch if ch.isalnum() else "_" for ch in self.model.name)
+
+    def to_c(self, directory=None, terms=("M", "C", "g", "tau")) -> dict:
+        """C source and header of ``terms``: ``{"NAME_dynamics.h": ..., "NAME_dynamics.c": ...}``,
+        written into ``directory`` when given. Each function is
+        ``void NAME_TERM(const double *q[, const double *qd, ...], double *out)`` with ``out``
+        row-major (see the header)."""
+        prefix = self.c_prefix()
+        base = f"{prefix}_dynamics"
+        progs = [self.program(t) for t in terms]
+        guard = base.upper() + "_H"
+        head = [f"/* Closed-form dynamics of {self.model.name!r} ({self.n} joints), derived by robodyn.symbolic",
+                f"   ({self.method.replace('_', '-')} method). M(q) qdd + C(q, qd) qd + g(q) = tau.",
+                "   Inputs are arrays of doubles: q, qd, qdd of length n"
+                + (f"; params = ({', '.join(s.name for s in self.parameters)})" if self.parameters else "")
+                + ". Outputs are row-major. */",
+                f"#ifndef {guard}", f"#define {guard}", "", f"#define {prefix.upper()}_NV {self.n}", ""]
+        for p in progs:
+            head += [f"/* {p.doc}; out has {max(1, len(p.outputs))} entries */", c_prototype_line(p, prefix), ""]
+        head += [f"#endif /* {guard} */", ""]
+        src = [f'/* Generated by robodyn.symbolic; see {base}.h */', "#include <math.h>",
+               f'#include "{base}.h"', ""]
+        src += [codegen.c_function(p, prefix) for p in progs]
+        files = {f"{base}.h": "\n".join(head), f"{base}.c": "\n".join(src)}
+        if directory is not None:
+            d = Path(directory)
+            d.mkdir(parents=True, exist_ok=True)
+            for k, v in files.items():
+                (d / k).write_text(v)
+        return files
+
+    def latex(self, name: str | None = None) -> str:
+        """LaTeX of one term (``name``), or with ``name=None`` a complete document with the
+        model and every term."""
+        from .latex import document, term_latex
+
+        if name is None:
+            return document(self)
+        return term_latex(self, name)
+
+
+def c_prototype_line(p, prefix):
+    return codegen.c_prototype(p, prefix) + ";"
+
+
+def equations_of_motion(model, method: str = "lagrange") -> EquationsOfMotion:
+    """Closed-form equations of motion of ``model`` (a :class:`robodyn.Model` with revolute
+    and prismatic joints on a fixed base, or a :class:`SymbolicModel`).
+
+    ``method="lagrange"``: Euler-Lagrange equations of ``T = qd^T M qd / 2`` and
+    ``U = -sum m_i g . p_ci`` (:mod:`.lagrange`); ``method="newton_euler"``: the recursive
+    Newton-Euler algorithm on symbols (:mod:`.newton_euler`). Both give identical terms.
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
+    sm = from_model(model)
+    rg = TrigRing(sm)
+    return EquationsOfMotion(sm, method, rg, METHODS[method](rg))

@@ -1,0 +1,87 @@
+"""LaTeX of the closed-form terms: one term, or a document with all of them.
+
+Joint symbols print as ``q_1``, ``\\dot{q}_1``, ``\\ddot{q}_1``; ``sin q_1`` and ``cos q_1``
+as ``s_1`` and ``c_1`` (defined at the top of the document), which keeps the formulas
+of a small robot readable.
+"""
+
+from __future__ import annotations
+
+import sympy as sp
+
+_DESCRIPTION = {
+    "M": "Mass matrix $M(q)$",
+    "C": r"Christoffel matrix $C(q, \dot q)$ ($\dot M - 2C$ is skew-symmetric)",
+    "C_qd": r"Coriolis and centrifugal forces $C(q, \dot q)\,\dot q$",
+    "g": "Gravity forces $g(q)$",
+    "T": "Kinetic energy $T$",
+    "U": "Potential energy $U$",
+    "L": "Lagrangian $L = T - U$",
+    "tau": r"Joint forces $\tau = M \ddot q + C \dot q + g$",
+}
+_LHS = {"M": "M", "C": "C", "C_qd": r"(C\dot q)", "g": "g", "tau": r"\tau", "T": "T", "U": "U", "L": "L"}
+
+
+def _names(eom) -> dict:
+    names = {}
+    for k in range(eom.n):
+        names[eom.q[k]] = f"q_{{{k + 1}}}"
+        names[eom.qd[k]] = rf"\dot{{q}}_{{{k + 1}}}"
+        names[eom.qdd[k]] = rf"\ddot{{q}}_{{{k + 1}}}"
+        s, c = eom._rg.trig_names(k)
+        names[s], names[c] = f"s_{{{k + 1}}}", f"c_{{{k + 1}}}"
+    return names
+
+
+def _tex(eom, e) -> str:
+    from .equations import readable_numbers
+
+    return sp.latex(readable_numbers(e), symbol_names=_names(eom))
+
+
+def _entries(eom, name: str) -> list[tuple[str, sp.Expr]]:
+    p = eom._poly[name]
+    rg = eom._rg
+    lhs = _LHS[name]
+    if name in ("M", "C"):
+        return [(f"{lhs}_{{{i + 1}{j + 1}}}", rg.expr(p[i][j], "symbols"))
+                for i in range(eom.n) for j in range(eom.n) if j >= i or name == "C"]
+    if isinstance(p, list):
+        return [(f"{lhs}_{{{i + 1}}}", rg.expr(x, "symbols")) for i, x in enumerate(p)]
+    return [(lhs, rg.expr(p, "symbols"))]
+
+
+def term_latex(eom, name: str) -> str:
+    """An ``align*`` environment with one line per entry of the term (``M`` and its
+    symmetric entries ``M_ij``, ``j >= i``)."""
+    rows = [rf"{lhs} &= {_tex(eom, e)}" for lhs, e in _entries(eom, name)]
+    return "\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}"
+
+
+def document(eom) -> str:
+    """A complete LaTeX document: the model, the notation and every term."""
+    m = eom.model
+    joints = ", ".join(f"{n} ({t})" for n, t in zip(m.joint_names, m.joint_type))
+    params = ", ".join(f"${sp.latex(s)}$" for s in eom.parameters) or "none (numeric model)"
+    notation = ", ".join(f"$s_{{{k + 1}}} = \\sin q_{{{k + 1}}}$, $c_{{{k + 1}}} = \\cos q_{{{k + 1}}}$"
+                         for k in range(eom.n) if eom._rg.revolute[k])
+    parts = [
+        r"\documentclass[10pt]{article}",
+        r"\usepackage{amsmath}",
+        r"\usepackage[margin=2cm]{geometry}",
+        r"\allowdisplaybreaks",
+        rf"\title{{Equations of motion of \texttt{{{m.name.replace('_', chr(92) + '_')}}}}}",
+        r"\date{}",
+        r"\begin{document}",
+        r"\maketitle",
+        rf"Derived by \texttt{{robodyn.symbolic}} ({eom.method.replace('_', '-')} method). "
+        rf"{eom.n} joints: {joints.replace('_', chr(92) + '_')}. Parameters: {params}.",
+        "",
+        r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) = \tau \]",
+        "",
+        f"Notation: {notation}." if notation else "",
+    ]
+    for name in ("M", "C", "g", "T", "U", "L", "tau"):
+        parts += [rf"\section*{{{_DESCRIPTION[name]}}}", term_latex(eom, name), ""]
+    parts.append(r"\end{document}")
+    return "\n".join(parts) + "\n"

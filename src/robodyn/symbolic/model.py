@@ -1,0 +1,290 @@
+"""Symbolic models: the fields of :class:`robodyn.Model` with sympy entries.
+
+A :class:`SymbolicModel` is a fixed-base tree of revolute and prismatic joints whose
+placements, joint axes, inertial parameters and gravity are sympy expressions (symbols or
+exact numbers). Body ``i`` hangs from body ``parent[i] < i``; its frame is placed in the
+parent frame at ``(R_tree[i], p_tree[i]) * X_J(q_i)`` exactly as in the numeric model, and
+its inertial parameters are ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` about the
+body origin in the body frame (``robodyn`` order). Joint ``k`` (1-based) has the coordinate
+``q{k}``, velocity ``qd{k}`` and acceleration ``qdd{k}``.
+
+Three ways to get one:
+
+* :func:`from_model`: a numeric :class:`robodyn.Model` with its numbers made exact (each
+  float becomes the rational of its shortest decimal representation, so ``0.4318`` is
+  ``2159/5000``; rotation entries within ``1e-12`` of 0 or +-1, the round-off of
+  ``cos(pi/2)``, become exactly 0 or +-1);
+* :func:`from_dh`: a Denavit-Hartenberg table (:class:`robodyn.DHLink` rows) whose entries
+  are sympy expressions or numbers, standard or modified convention;
+* :func:`with_inertia_symbols`: any of them with the inertial parameters replaced by the
+  named symbols ``m1, mx1, my1, mz1, Ixx1, Ixy1, Iyy1, Ixz1, Iyz1, Izz1, m2, ...``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from fractions import Fraction
+from typing import Sequence
+
+import numpy as np
+import sympy as sp
+
+from .. import joints as J
+from ..errors import ModelError
+
+JOINT_TYPES = ("revolute", "prismatic")
+PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+# Rotation entries this close to 0 or +-1 are the round-off of cos(pi/2) and the like.
+SNAP_TOL = 1e-12
+
+
+def exact(x, snap: bool = False) -> sp.Expr:
+    """A sympy number or expression for ``x``: floats become the rational of their shortest
+    decimal representation; with ``snap``, values within ``SNAP_TOL`` of 0, 1 or -1 become
+    those integers."""
+    if isinstance(x, sp.Basic):
+        if isinstance(x, sp.Float):
+            return exact(float(x), snap)
+        return x.xreplace({f: exact(float(f), snap) for f in x.atoms(sp.Float)}) if x.atoms(sp.Float) else x
+    if isinstance(x, (int, np.integer)):
+        return sp.Integer(int(x))
+    v = float(x)
+    if not np.isfinite(v):
+        raise ValueError(f"expected a finite number, got {x!r}")
+    if snap:
+        for k in (0, 1, -1):
+            if abs(v - k) <= SNAP_TOL:
+                return sp.Integer(k)
+    f = Fraction(repr(v))
+    return sp.Rational(f.numerator, f.denominator)
+
+
+def _vec(x, n: int, what: str) -> sp.Matrix:
+    m = sp.Matrix(x) if not isinstance(x, sp.MatrixBase) else x
+    if m.shape not in ((n, 1), (1, n)):
+        raise ValueError(f"{what}: expected {n} entries, got shape {m.shape}")
+    return sp.Matrix(n, 1, [exact(e) for e in m])
+
+
+def _mat3(x, what: str, snap: bool = False) -> sp.Matrix:
+    m = sp.Matrix(x)
+    if m.shape != (3, 3):
+        raise ValueError(f"{what}: expected shape (3, 3), got {m.shape}")
+    return m.applyfunc(lambda e: exact(e, snap))
+
+
+def skew(v) -> sp.Matrix:
+    """``[v]x``, the 3 x 3 cross-product matrix of ``v``."""
+    return sp.Matrix([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def inertial_parameters(mass, com, inertia_com) -> list:
+    """The 10 inertial parameters about the frame origin from the mass, the centre of mass
+    (3,) and the inertia (3, 3) about the centre of mass (same frame), by the parallel-axis
+    theorem ``I_o = I_c + m [c]x^T [c]x``; entries may be symbols."""
+    m = exact(mass)
+    c = _vec(com, 3, "com")
+    Io = _mat3(inertia_com, "inertia") + m * (skew(c).T * skew(c))
+    h = m * c
+    return [m, h[0], h[1], h[2], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
+
+
+def inertia_symbols(body: int) -> list[sp.Symbol]:
+    """``m{k}, mx{k}, my{k}, mz{k}, Ixx{k}, Ixy{k}, Iyy{k}, Ixz{k}, Iyz{k}, Izz{k}`` for body
+    ``k = body`` (1-based), in robodyn's parameter order (``mx = m cx`` and so on, inertias
+    about the body origin)."""
+    return [sp.Symbol(f"{n}{body}", real=True) for n in PARAMETER_NAMES]
+
+
+@dataclass(frozen=True)
+class SymbolicModel:
+    """A fixed-base tree with sympy entries (see the module docstring).
+
+    Per body ``i`` (``nb`` bodies, each with one joint): ``parent[i]`` (``-1``: the world),
+    ``joint_type[i]`` (``"revolute"`` or ``"prismatic"``), ``axis[i]`` (3 x 1, unit, body
+    frame), ``R_tree[i]`` (3 x 3) and ``p_tree[i]`` (3 x 1) (joint frame in the parent frame),
+    ``inertia[i]`` (10 parameters). Per joint: ``armature`` (rotor inertia on the diagonal of
+    ``M``). ``gravity`` (3 x 1, world frame). ``q``, ``qd``, ``qdd``: the joint symbols.
+    """
+
+    parent: tuple
+    joint_type: tuple
+    axis: tuple
+    R_tree: tuple
+    p_tree: tuple
+    inertia: tuple
+    gravity: sp.Matrix
+    armature: tuple = ()
+    name: str = "robot"
+    link_names: tuple = ()
+    joint_names: tuple = ()
+    q: tuple = field(init=False)
+    qd: tuple = field(init=False)
+    qdd: tuple = field(init=False)
+
+    def __post_init__(self):
+        nb = len(self.parent)
+        set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
+        for what in ("joint_type", "axis", "R_tree", "p_tree", "inertia"):
+            if len(getattr(self, what)) != nb:
+                raise ModelError(f"{what}: expected {nb} entries (one per body), got {len(getattr(self, what))}")
+        for i, p in enumerate(self.parent):
+            if not -1 <= int(p) < i:
+                raise ModelError(f"body {i}: parent index {p} must satisfy -1 <= parent < {i}")
+            if self.joint_type[i] not in JOINT_TYPES:
+                raise ModelError(f"body {i}: joint type must be one of {JOINT_TYPES}, got {self.joint_type[i]!r}")
+            if len(self.inertia[i]) != 10:
+                raise ModelError(f"body {i}: expected 10 inertial parameters, got {len(self.inertia[i])}")
+        set_("parent", tuple(int(p) for p in self.parent))
+        set_("axis", tuple(_vec(a, 3, f"axis[{i}]") for i, a in enumerate(self.axis)))
+        set_("R_tree", tuple(_mat3(R, f"R_tree[{i}]") for i, R in enumerate(self.R_tree)))
+        set_("p_tree", tuple(_vec(p, 3, f"p_tree[{i}]") for i, p in enumerate(self.p_tree)))
+        set_("inertia", tuple(tuple(exact(t) for t in th) for th in self.inertia))
+        set_("gravity", _vec(self.gravity, 3, "gravity"))
+        arm = tuple(exact(a) for a in self.armature) if self.armature else (sp.Integer(0),) * nb
+        if len(arm) != nb:
+            raise ModelError(f"armature: expected {nb} entries, got {len(arm)}")
+        set_("armature", arm)
+        set_("link_names", tuple(self.link_names) or tuple(f"link{i + 1}" for i in range(nb)))
+        set_("joint_names", tuple(self.joint_names) or tuple(f"joint{i + 1}" for i in range(nb)))
+        set_("q", tuple(sp.Symbol(f"q{k + 1}", real=True) for k in range(nb)))
+        set_("qd", tuple(sp.Symbol(f"qd{k + 1}", real=True) for k in range(nb)))
+        set_("qdd", tuple(sp.Symbol(f"qdd{k + 1}", real=True) for k in range(nb)))
+
+    @property
+    def nbodies(self) -> int:
+        return len(self.parent)
+
+    @property
+    def nv(self) -> int:
+        return len(self.parent)
+
+    def inertial_parameters(self) -> list:
+        """All inertial parameters (10 * nbodies), body after body."""
+        return [t for th in self.inertia for t in th]
+
+    def parameters(self) -> list[sp.Symbol]:
+        """The free symbols of the model (lengths, masses, ..., gravity), sorted by name;
+        the joint symbols are not parameters."""
+        syms = set(self.gravity.free_symbols)
+        for i in range(self.nbodies):
+            for x in (self.axis[i], self.R_tree[i], self.p_tree[i]):
+                syms |= x.free_symbols
+            for t in (*self.inertia[i], self.armature[i]):
+                syms |= t.free_symbols
+        return sorted(syms, key=lambda s: s.name)
+
+    def replace(self, **changes) -> "SymbolicModel":
+        """A new model with some fields changed."""
+        return replace(self, **changes)
+
+    def __repr__(self) -> str:
+        return (f"SymbolicModel {self.name!r}: {self.nbodies} bodies, joints "
+                f"{''.join('R' if t == 'revolute' else 'P' for t in self.joint_type)}, "
+                f"parameters {[s.name for s in self.parameters()]}")
+
+
+def from_model(model) -> SymbolicModel:
+    """The :class:`SymbolicModel` of a numeric :class:`robodyn.Model` with exact numbers
+    (module docstring). Revolute and prismatic joints on a fixed base only."""
+    if isinstance(model, SymbolicModel):
+        return model
+    if model.floating_base or np.any(model.joint_type == J.FREE):
+        raise ModelError(
+            f"model {model.name!r} has a floating base (free joint); robodyn.symbolic derives "
+            "fixed-base trees of revolute and prismatic joints only"
+        )
+    return SymbolicModel(
+        parent=tuple(model.parent.tolist()),
+        joint_type=tuple(J.NAMES[t] for t in model.joint_type),
+        axis=tuple([exact(a, snap=True) for a in ax] for ax in model.joint_axis),
+        R_tree=tuple(sp.Matrix(3, 3, [exact(x, snap=True) for x in R.ravel()]) for R in model.X_tree_R),
+        p_tree=tuple([exact(x) for x in p] for p in model.X_tree_p),
+        inertia=tuple([exact(x) for x in th] for th in model.inertia),
+        gravity=[exact(x) for x in model.gravity],
+        armature=tuple(exact(a) for a in model.armature),
+        name=model.name,
+        link_names=model.link_names,
+        joint_names=model.body_joint_names,
+    )
+
+
+def with_inertia_symbols(model) -> SymbolicModel:
+    """``model`` (numeric or symbolic) with the inertial parameters of body ``k`` replaced
+    by ``m{k}, mx{k}, my{k}, mz{k}, Ixx{k}, Ixy{k}, Iyy{k}, Ixz{k}, Iyz{k}, Izz{k}``
+    (1-based, :func:`inertia_symbols`); ``model.inertial_parameters()`` of the result is
+    the parameter vector ``theta`` of ``tau = Y theta``."""
+    sm = from_model(model)
+    return sm.replace(inertia=tuple(inertia_symbols(i + 1) for i in range(sm.nbodies)))
+
+
+def _rx(a) -> sp.Matrix:
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def _rz(a) -> sp.Matrix:
+    c, s = sp.cos(a), sp.sin(a)
+    return sp.Matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def _T(R=None, p=(0, 0, 0)) -> sp.Matrix:
+    T = sp.eye(4)
+    if R is not None:
+        T[:3, :3] = R
+    T[:3, 3] = sp.Matrix(p)
+    return T
+
+
+def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Rational(981, 100)),
+            name: str = "dh_robot") -> SymbolicModel:
+    """A serial chain from a DH table whose entries are sympy expressions or numbers.
+
+    ``links``: :class:`robodyn.DHLink` rows (``a, alpha, d, offset, joint, theta, mass, com,
+    inertia`` are read; ``inertia`` is 3 x 3 about the centre of mass in DH frame ``i``,
+    ``com`` in DH frame ``i``, as in :func:`robodyn.from_dh`). Standard DH:
+    ``T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; modified (Craig):
+    ``T_{i-1,i} = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i)``, with
+    ``theta_i = q_i + offset`` (revolute) or ``d_i = q_i + offset`` (prismatic).
+    Body ``i``'s frame is the joint frame (z along the joint axis); the part of the DH
+    transform after the joint (standard DH: ``Tz(d) Tx(a) Rx(alpha)`` of a revolute joint)
+    is folded into the next body's placement and into body ``i``'s inertial parameters.
+    ``gravity`` defaults to ``(0, 0, -9.81)`` as an exact number; pass ``(0, 0, -g)`` with a
+    symbol ``g`` for textbook forms.
+    """
+    if convention not in ("standard", "modified"):
+        raise ValueError(f"convention must be 'standard' or 'modified', got {convention!r}")
+    links = list(links)
+    if not links:
+        raise ModelError("from_dh: empty DH table")
+    post_prev = sp.eye(4)
+    R_tree, p_tree, inertia, types = [], [], [], []
+    for i, L in enumerate(links, start=1):
+        where = f"DH table ({convention}): link {i}"
+        if L.joint not in JOINT_TYPES:
+            raise ModelError(f"{where}: joint must be 'revolute' or 'prismatic', got {L.joint!r}")
+        a, alpha, d, off, th = (exact(x) for x in (L.a, L.alpha, L.d, L.offset, L.theta))
+        rev = L.joint == "revolute"
+        if convention == "standard":
+            pre = _T(_rz(off)) if rev else _T(_rz(th)) * _T(p=(0, 0, off))
+            post = (_T(p=(0, 0, d)) if rev else sp.eye(4)) * _T(p=(a, 0, 0)) * _T(_rx(alpha))
+        else:
+            pre = _T(_rx(alpha)) * _T(p=(a, 0, 0))
+            pre = pre * (_T(p=(0, 0, d)) * _T(_rz(off)) if rev else _T(_rz(th)) * _T(p=(0, 0, off)))
+            post = sp.eye(4)
+        X = post_prev * pre
+        R_tree.append(X[:3, :3])
+        p_tree.append(X[:3, 3])
+        # inertia given in DH frame i = body frame * post: move it into the body frame
+        Rp, pp = post[:3, :3], post[:3, 3]
+        com = Rp * _vec(L.com, 3, f"{where}: com") + pp
+        Ic = Rp * _mat3(L.inertia, f"{where}: inertia") * Rp.T
+        inertia.append([sp.expand(t) for t in inertial_parameters(L.mass, com, Ic)])
+        types.append(L.joint)
+        post_prev = post
+    n = len(links)
+    return SymbolicModel(
+        parent=tuple(range(-1, n - 1)), joint_type=tuple(types), axis=tuple([0, 0, 1] for _ in range(n)),
+        R_tree=tuple(R_tree), p_tree=tuple(p_tree), inertia=tuple(inertia), gravity=list(gravity),
+        armature=tuple(getattr(L, "armature", 0) for L in links), name=name,
+    )

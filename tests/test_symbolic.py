@@ -1,0 +1,353 @@
+"""robodyn.symbolic: closed forms against textbooks, the two derivation routes against each
+other, and the generated code (NumPy, Numba, C) against the numeric kernels."""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import robodyn as rd
+from robodyn import symbolic as S
+from robodyn.io.dh import DHLink
+from robodyn.models import panda
+
+from helpers import assert_rel, rng_for
+
+# every built-in robot with at most 6 joints
+SMALL_ROBOTS = ["pendulum", "double_pendulum", "planar_2r", "elbow_3r", "scara", "puma560", "ur5"]
+g, l1, l2, r1, r2 = sp.symbols("g l1 l2 r1 r2", positive=True)
+
+
+@pytest.fixture(scope="module")
+def derived():
+    """Each built-in robot derived once per module (Lagrange route) with its NumPy functions."""
+    out = {}
+    for name in SMALL_ROBOTS:
+        model = rd.models.load(name)
+        eom = S.equations_of_motion(model)
+        out[name] = (model, eom, {t: eom.to_function(t) for t in ("M", "C", "g", "tau", "T", "U")})
+    return out
+
+
+def random_states(model, n=8, *keys):
+    rng = rng_for(model.name, *keys)
+    return (rng.uniform(-np.pi, np.pi, (n, model.nq)), rng.uniform(-2, 2, (n, model.nv)),
+            rng.uniform(-3, 3, (n, model.nv)))
+
+
+# -- generated functions against the numeric kernels ----------------------------------------
+@pytest.mark.parametrize("name", SMALL_ROBOTS)
+def test_generated_functions_match_numeric_kernels(derived, name):
+    model, eom, f = derived[name]
+    q, v, a = random_states(model)
+    assert_rel(f["M"](q), rd.crba(model, q), 1e-10, "M")
+    assert_rel(f["C"](q, v), rd.coriolis_matrix(model, q, v), 1e-10, "C")
+    assert_rel(f["g"](q), rd.gravity(model, q), 1e-10, "g")
+    assert_rel(f["tau"](q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
+    rotor = 0.5 * np.einsum("k,bk,bk->b", model.armature, v, v)
+    assert_rel(f["T"](q, v), rd.kinetic_energy(model, q, v) + rotor, 1e-10, "T")
+    assert_rel(f["U"](q), rd.potential_energy(model, q), 1e-10, "U")
+    # one state in, one state out
+    assert_rel(f["M"](q[0]), rd.crba(model, q[0]), 1e-10, "M, one state")
+
+
+def test_generated_function_checks_shapes(derived):
+    model, eom, f = derived["planar_2r"]
+    with pytest.raises(ValueError, match=r"q: expected shape \(\.\.\., 2\), got \(3,\)"):
+        f["M"](np.zeros(3))
+    with pytest.raises(ValueError, match=r"qd: expected shape \(\.\.\., 2\)"):
+        f["C"](np.zeros(2), np.zeros(5))
+
+
+def test_numba_functions(derived):
+    model, eom, _ = derived["elbow_3r"]
+    q, v, a = random_states(model, 16, "numba")
+    M, C, tau = eom.to_numba("M"), eom.to_numba("C"), eom.to_numba("tau")
+    assert_rel(M(q), rd.crba(model, q), 1e-10, "M")
+    assert_rel(M(q[3]), rd.crba(model, q[3]), 1e-10, "M, one state")
+    assert_rel(C(q, v), rd.coriolis_matrix(model, q, v), 1e-10, "C")
+    assert_rel(tau(q.reshape(4, 4, 3), v.reshape(4, 4, 3), a.reshape(4, 4, 3)),
+               rd.rnea(model, q, v, a, friction=False).reshape(4, 4, 3), 1e-10, "tau, 2-d batch")
+
+
+def compile_c(files: dict, directory, name):
+    cc = shutil.which("cc") or shutil.which("gcc")
+    assert cc, "a C compiler (cc or gcc) is required to test the generated C code"
+    src = [str(directory / k) for k in files if k.endswith(".c")]
+    lib = directory / f"lib{name}.so"
+    subprocess.run([cc, "-O0", "-shared", "-fPIC", "-o", str(lib), *src, "-lm"], check=True, capture_output=True)
+    return ctypes.CDLL(str(lib))
+
+
+def call_c(fn, out_size, *arrays):
+    out = np.zeros(out_size)
+    ptr = ctypes.POINTER(ctypes.c_double)
+    args = [np.ascontiguousarray(x, dtype=float).ctypes.data_as(ptr) for x in arrays]
+    fn(*args, out.ctypes.data_as(ptr))
+    return out
+
+
+@pytest.mark.parametrize("name", ["elbow_3r", "puma560"])
+def test_c_code_compiles_and_matches(derived, name, tmp_path):
+    model, eom, _ = derived[name]
+    files = eom.to_c(tmp_path)
+    assert set(files) == {f"{name}_dynamics.h", f"{name}_dynamics.c"}
+    header = (tmp_path / f"{name}_dynamics.h").read_text()
+    for term in ("M", "C", "g", "tau"):
+        assert f"void {name}_{term}(const double *q" in header
+    lib = compile_c(files, tmp_path, name)
+    n = model.nv
+    for q, v, a in zip(*random_states(model, 4, "c")):
+        assert_rel(call_c(lib[f"{name}_M"], n * n, q).reshape(n, n), rd.crba(model, q), 1e-10, "M")
+        assert_rel(call_c(lib[f"{name}_C"], n * n, q, v).reshape(n, n), rd.coriolis_matrix(model, q, v), 1e-10, "C")
+        assert_rel(call_c(lib[f"{name}_g"], n, q), rd.gravity(model, q), 1e-10, "g")
+        assert_rel(call_c(lib[f"{name}_tau"], n, q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
+
+
+# -- the two routes -------------------------------------------------------------------------
+def spherical_pendulum():
+    """Point mass m on a massless rod of length l; q1 = azimuth phi about the vertical z,
+    q2 = polar angle theta from the downward vertical (about the turned y axis)."""
+    m, l = sp.symbols("m l", positive=True)
+    return S.SymbolicModel(
+        parent=(-1, 0), joint_type=("revolute", "revolute"), axis=([0, 0, 1], [0, 1, 0]),
+        R_tree=(sp.eye(3), sp.eye(3)), p_tree=([0, 0, 0], [0, 0, 0]),
+        inertia=([0] * 10, S.inertial_parameters(m, [0, 0, -l], sp.zeros(3))),
+        gravity=[0, 0, -g], name="spherical_pendulum"), m, l
+
+
+def planar_2r_symbolic():
+    """Two-link planar arm in the x-y plane, gravity along -y (Murray-Li-Sastry notation)."""
+    m1, m2, Iz1, Iz2 = sp.symbols("m1 m2 Iz1 Iz2", positive=True)
+    links = [DHLink(a=l1, alpha=0, d=0, mass=m1, com=(r1 - l1, 0, 0), inertia=sp.diag(0, Iz1, Iz1)),
+             DHLink(a=l2, alpha=0, d=0, mass=m2, com=(r2 - l2, 0, 0), inertia=sp.diag(0, Iz2, Iz2))]
+    return S.from_dh(links, gravity=(0, -g, 0), name="planar_2r"), (m1, m2, Iz1, Iz2)
+
+
+def scara_symbolic():
+    """Spong's RRPR SCARA with symbolic lengths, masses and inertias (diagonal, at the
+    centres of mass; links 3 and 4 centred on the vertical axis)."""
+    a1, a2, d1, c3 = sp.symbols("a1 a2 d1 c3", real=True)
+    m = sp.symbols("m1:5", positive=True)
+    I = [sp.symbols(f"Ix{k} Iy{k} Iz{k}", positive=True) for k in range(1, 5)]
+    links = [
+        DHLink(a=a1, alpha=0, d=d1, mass=m[0], com=(r1 - a1, 0, 0), inertia=sp.diag(*I[0])),
+        DHLink(a=a2, alpha=sp.pi, d=0, mass=m[1], com=(r2 - a2, 0, 0), inertia=sp.diag(*I[1])),
+        DHLink(a=0, alpha=0, d=0, theta=0, joint="prismatic", mass=m[2], com=(0, 0, c3), inertia=sp.diag(*I[2])),
+        DHLink(a=0, alpha=0, d=0, mass=m[3], inertia=sp.diag(*I[3])),
+    ]
+    return S.from_dh(links, gravity=(0, 0, -g), name="scara"), (a1, a2, m, I)
+
+
+def routes_models():
+    return {
+        "pendulum": S.with_inertia_symbols(rd.models.load("pendulum")),
+        "spherical_pendulum": spherical_pendulum()[0],
+        "planar_2r": planar_2r_symbolic()[0],
+        "elbow_3r": S.with_inertia_symbols(rd.models.load("elbow_3r")),
+        "scara": scara_symbolic()[0],
+    }
+
+
+def is_zero(expr) -> bool:
+    return all(sp.simplify(e) == 0 for e in sp.Matrix([expr]))
+
+
+@pytest.mark.parametrize("name", ["pendulum", "spherical_pendulum", "planar_2r", "elbow_3r", "scara"])
+def test_lagrange_and_newton_euler_agree(name):
+    model = routes_models()[name]
+    lag = S.equations_of_motion(model, "lagrange")
+    ne = S.equations_of_motion(model, "newton_euler")
+    for term in ("M", "C", "C_qd", "g", "T", "U", "tau"):
+        assert lag.equals(ne, term), term
+        assert is_zero(lag.term(term) - ne.term(term)), term
+    assert lag.parameters and lag.parameters == ne.parameters
+
+
+@pytest.mark.parametrize("method", ["lagrange", "newton_euler"])
+def test_christoffel_matrix_properties(method):
+    eom = S.equations_of_motion(planar_2r_symbolic()[0], method)
+    M, C = eom.M, eom.C
+    Mdot = sp.zeros(2, 2)
+    for k in range(2):
+        Mdot += M.diff(eom.q[k]) * eom.qd[k]
+    N = Mdot - 2 * C
+    assert is_zero(N + N.T)
+    qd = sp.Matrix(eom.qd)
+    assert is_zero(C * qd - eom.C_qd)
+    qdd = sp.Matrix(eom.qdd)
+    assert is_zero(M * qdd + C * qd + eom.g - eom.tau)
+    assert is_zero(eom.L - (eom.T - eom.U))
+    assert is_zero(eom.T - (qd.T * M * qd)[0] / 2)
+
+
+# -- textbook closed forms ------------------------------------------------------------------
+@pytest.mark.parametrize("method", ["lagrange", "newton_euler"])
+def test_spherical_pendulum_equations(method):
+    model, m, l = spherical_pendulum()
+    eom = S.equations_of_motion(model, method)
+    phi, th = eom.q
+    phid, thd = eom.qd
+    phidd, thdd = eom.qdd
+    expected = sp.Matrix([
+        m * l**2 * sp.sin(th) ** 2 * phidd + 2 * m * l**2 * sp.sin(th) * sp.cos(th) * thd * phid,
+        m * l**2 * thdd - m * l**2 * sp.sin(th) * sp.cos(th) * phid**2 + m * g * l * sp.sin(th),
+    ])
+    assert is_zero(eom.tau - expected)
+    assert is_zero(eom.T - m * l**2 * (thd**2 + sp.sin(th) ** 2 * phid**2) / 2)
+    assert is_zero(eom.U + m * g * l * sp.cos(th))
+
+
+@pytest.mark.parametrize("method", ["lagrange", "newton_euler"])
+def test_two_link_planar_arm(method):
+    model, (m1, m2, Iz1, Iz2) = planar_2r_symbolic()
+    eom = S.equations_of_motion(model, method)
+    q1, q2 = eom.q
+    qd1, qd2 = eom.qd
+    alpha = Iz1 + Iz2 + m1 * r1**2 + m2 * (l1**2 + r2**2)
+    beta = m2 * l1 * r2
+    delta = Iz2 + m2 * r2**2
+    c2, s2 = sp.cos(q2), sp.sin(q2)
+    M = sp.Matrix([[alpha + 2 * beta * c2, delta + beta * c2], [delta + beta * c2, delta]])
+    C = sp.Matrix([[-beta * s2 * qd2, -beta * s2 * (qd1 + qd2)], [beta * s2 * qd1, 0]])
+    G = sp.Matrix([(m1 * r1 + m2 * l1) * g * sp.cos(q1) + m2 * r2 * g * sp.cos(q1 + q2),
+                   m2 * r2 * g * sp.cos(q1 + q2)])
+    assert is_zero(eom.M - M)
+    assert is_zero(eom.C - C)
+    assert is_zero(eom.g - G)
+    # trigonometric rules applied to small terms: the textbook's cos(q1 + q2) appears
+    assert eom.g[1] == m2 * r2 * g * sp.cos(q1 + q2)
+
+
+def test_scara_inertia_matrix():
+    model, (a1, a2, m, I) = scara_symbolic()
+    eom = S.equations_of_motion(model)
+    c2 = sp.cos(eom.q[1])
+    Iz = [Ik[2] for Ik in I]
+    m1, m2, m3, m4 = m
+    d11 = (Iz[0] + m1 * r1**2 + Iz[1] + m2 * (a1**2 + r2**2 + 2 * a1 * r2 * c2)
+           + (m3 + m4) * (a1**2 + a2**2 + 2 * a1 * a2 * c2) + Iz[2] + Iz[3])
+    d12 = Iz[1] + m2 * (r2**2 + a1 * r2 * c2) + (m3 + m4) * (a2**2 + a1 * a2 * c2) + Iz[2] + Iz[3]
+    d22 = Iz[1] + m2 * r2**2 + (m3 + m4) * a2**2 + Iz[2] + Iz[3]
+    expected = sp.Matrix([[d11, d12, 0, -Iz[3]], [d12, d22, 0, -Iz[3]], [0, 0, m3 + m4, 0],
+                          [-Iz[3], -Iz[3], 0, Iz[3]]])
+    assert is_zero(eom.M - expected)
+    assert is_zero(eom.g - sp.Matrix([0, 0, -(m3 + m4) * g, 0]))
+
+
+# -- models -------------------------------------------------------------------------------
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_symbolic_dh_matches_numeric_dh(convention):
+    links = panda.links()[:3]
+    if convention == "standard":
+        links = [DHLink(a=L.a, alpha=L.alpha, d=L.d, offset=0.3, mass=L.mass, com=L.com, inertia=L.inertia)
+                 for L in links]
+    model = rd.from_dh(links, convention=convention)
+    eom = S.equations_of_motion(S.from_dh(links, convention=convention))
+    q, v, _ = random_states(model, 6, convention)
+    assert_rel(eom.to_function("M")(q), rd.crba(model, q), 1e-10, "M")
+    assert_rel(eom.to_function("C")(q, v), rd.coriolis_matrix(model, q, v), 1e-10, "C")
+    assert_rel(eom.to_function("g")(q), rd.gravity(model, q), 1e-10, "g")
+
+
+def test_inertia_symbols_and_parameters():
+    model = S.with_inertia_symbols(rd.models.load("planar_2r"))
+    names = [s.name for s in model.inertial_parameters()]
+    assert names == ["m1", "mx1", "my1", "mz1", "Ixx1", "Ixy1", "Iyy1", "Ixz1", "Iyz1", "Izz1",
+                     "m2", "mx2", "my2", "mz2", "Ixx2", "Ixy2", "Iyy2", "Ixz2", "Iyz2", "Izz2"]
+    eom = S.equations_of_motion(model)
+    assert [s.name for s in eom.parameters] == sorted(names)
+    # the generated function takes the parameters; with the model's numbers it is rd.crba
+    numeric = rd.models.load("planar_2r")
+    values = dict(zip(names, numeric.inertial_parameters()))
+    params = np.array([values[s.name] for s in eom.parameters])
+    q, v, a = random_states(numeric, 5, "params")
+    assert_rel(eom.to_function("M")(q, params), rd.crba(numeric, q), 1e-10, "M with parameters")
+    assert_rel(eom.to_function("tau")(q, v, a, params), rd.rnea(numeric, q, v, a), 1e-10, "tau with parameters")
+
+
+def test_floating_base_is_rejected():
+    model = rd.random.random_model(3, seed=1, floating_base=True)
+    with pytest.raises(rd.ModelError, match="floating base"):
+        S.equations_of_motion(model)
+    with pytest.raises(ValueError, match="method must be one of"):
+        S.equations_of_motion(rd.models.load("pendulum"), method="kane")
+
+
+def test_prismatic_joints_on_a_random_tree():
+    """A branching tree with revolute and prismatic joints along arbitrary axes."""
+    for seed in range(3):
+        model = rd.random.random_model(4, seed=seed, floating_base=False, branching=0.6)
+        eom = S.equations_of_motion(model, "newton_euler")
+        q, v, a = random_states(model, 4, seed)
+        assert_rel(eom.to_function("M")(q), rd.crba(model, q), 1e-9, "M")
+        assert_rel(eom.to_function("C")(q, v), rd.coriolis_matrix(model, q, v), 1e-9, "C")
+        assert_rel(eom.to_function("tau")(q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-9, "tau")
+
+
+# -- regressor ----------------------------------------------------------------------------
+@pytest.mark.parametrize("name", ["elbow_3r", "scara"])
+def test_regressor(name):
+    model = rd.models.load(name)
+    reg = S.regressor(model)
+    assert [s.name for s in reg.theta[:10]] == ["m1", "mx1", "my1", "mz1", "Ixx1", "Ixy1", "Iyy1", "Ixz1", "Iyz1",
+                                                "Izz1"]
+    Y = reg.to_function()
+    q, v, a = random_states(model, 6, "regressor")
+    theta = model.inertial_parameters()
+    assert_rel(Y(q, v, a) @ theta, rd.rnea(model, q, v, a, friction=False, armature=False), 1e-10, "Y theta")
+    # linear in theta: Y itself does not contain the parameters
+    assert not (reg.Y.free_symbols & set(reg.theta))
+    assert reg.Y.shape == (model.nv, 10 * model.nbodies)
+
+
+# -- LaTeX, CLI, import ---------------------------------------------------------------------
+def test_latex_document(derived):
+    _, eom, _ = derived["planar_2r"]
+    doc = eom.latex()
+    assert doc.startswith(r"\documentclass") and doc.rstrip().endswith(r"\end{document}")
+    for section in ("Mass matrix", "Christoffel matrix", "Gravity forces", "Kinetic energy", "Potential energy",
+                    "Lagrangian", "Joint forces"):
+        assert section in doc
+    tex = eom.latex("M")
+    assert tex.count("&=") == 3  # M_11, M_12, M_22
+    assert r"M_{11} &= 5 c_{2} + 10.0" in tex and r"M_{22} &= 1.666666666666667" in tex
+    assert r"\dot{q}_{2}" in eom.latex("C")
+
+
+def test_cli_derive(tmp_path, capsys):
+    from robodyn.cli import main
+
+    tex, cdir = tmp_path / "p2r.tex", tmp_path / "c"
+    code = main(["derive", "planar_2r", "--method", "newton_euler", "--latex", str(tex), "--c", str(cdir)])
+    out = capsys.readouterr().out
+    assert code == 0
+    assert "2 joints, newton-euler method" in out
+    files = {p.name: p for p in cdir.iterdir()}
+    assert set(files) == {"planar_2r_dynamics.h", "planar_2r_dynamics.c"}
+    assert all(p.stat().st_size > 0 for p in files.values()) and tex.stat().st_size > 0
+    assert r"\begin{document}" in tex.read_text() and r"M_{12}" in tex.read_text()
+    # the written C code computes the model's mass matrix and gravity
+    model = rd.models.load("planar_2r")
+    lib = compile_c({k: None for k in files}, cdir, "p2r")
+    q = np.array([0.3, -1.1])
+    assert_rel(call_c(lib.planar_2r_M, 4, q).reshape(2, 2), rd.crba(model, q), 1e-12, "M")
+    assert_rel(call_c(lib.planar_2r_g, 2, q), rd.gravity(model, q), 1e-12, "g")
+
+
+def test_cli_derive_errors(capsys):
+    from robodyn.cli import main
+
+    assert main(["derive", "no_such_robot"]) == 2
+    assert "unknown model" in capsys.readouterr().err
+
+
+def test_import_robodyn_does_not_import_sympy():
+    code = "import sys, robodyn; assert 'sympy' not in sys.modules; robodyn.symbolic; assert 'sympy' in sys.modules"
+    subprocess.run([sys.executable, "-c", code], check=True)
