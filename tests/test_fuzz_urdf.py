@@ -131,7 +131,7 @@ def mutate(text: str, rng: random.Random, kind: str, size: int = 100_000) -> str
         return _with_entity(text, rng, kind)
     root = ET.fromstring(text)
     if kind == "deep_nesting":  # a random element wrapped in 100 levels (the limit is 64)
-        elem = rng.choice(list(root))
+        elem = rng.choice(list(root) or [ET.Element("link", name="extra")])
         for _ in range(100):
             wrapper = ET.Element("nest")
             wrapper.append(elem)

@@ -185,6 +185,22 @@ def unflatten(out: np.ndarray, batch: tuple) -> np.ndarray:
     return out if batch == () else out.reshape(batch + out.shape[1:])
 
 
+def raise_nonfinite_result(what: str, arrays: dict):
+    """Raise the ``ValueError`` of a result that is not finite although its inputs are."""
+    big = max((float(np.abs(a).max()) for a in arrays.values() if np.size(a)), default=0.0)
+    raise ValueError(
+        f"{what}: the result is not finite although every input is (largest input magnitude {big:.3g}): "
+        "the computation overflowed or divided by zero; check the scale of the inputs and the model's "
+        "masses and inertias")
+
+
+def require_finite_result(what: str, out: np.ndarray, check: bool, arrays: dict) -> np.ndarray:
+    """``out``, after checking (when ``check``) that it is finite (for results computed in NumPy)."""
+    if check and not np.isfinite(out).all():
+        raise_nonfinite_result(what, arrays)
+    return out
+
+
 def raise_for_status(model, status, arrays: dict, what: str) -> int:
     """Raise the ``ValueError`` a kernel status stands for; return the failing body + 1 (or 0).
 
@@ -212,11 +228,7 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
                                  "pass check_finite=False to skip this check")
         raise AssertionError("kernel reported a non-finite input that is not there")
     if code == NONFINITE_RESULT:
-        big = max((float(np.abs(a).max()) for a in arrays.values() if np.size(a)), default=0.0)
-        raise ValueError(
-            f"{what}: the result is not finite although every input is (largest input magnitude {big:.3g}): "
-            "the computation overflowed or divided by zero; check the scale of the inputs and the model's "
-            "masses and inertias")
+        raise_nonfinite_result(what, arrays)
     if code == BAD_QUATERNION:
         q = arrays["q"]
         for i in np.flatnonzero(model.joint_type == J.FREE):
