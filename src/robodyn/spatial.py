@@ -23,7 +23,6 @@ nothing in their loops. Reference: R. Featherstone, *Rigid Body Dynamics Algorit
 
 from __future__ import annotations
 
-import numpy as np
 
 from ._jit import inline
 

@@ -15,6 +15,9 @@ Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = iX_p a_p + c_i``,
 
 A body whose ``D_i`` is singular (a massless leaf, a point mass on its joint axis) makes the
 forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
+
+The recursion is written once, as the hybrid dynamics (:func:`hybrid_one`, RBDA section 9.2,
+used by ``hybrid.py``): the ABA is its case with no joint of known acceleration.
 """
 
 from __future__ import annotations
@@ -40,7 +43,7 @@ def workspace(nb, nv):
             np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6, 6)), np.empty((nb, 6)),
             np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)), np.empty(nv), np.empty((3, 3)),
             np.empty(3), np.empty((3, 3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((6, 12)),
-            np.empty(6), np.empty(6), np.empty((6, 6)))
+            np.empty(6), np.empty(6), np.empty((6, 6)), np.zeros(nv, dtype=np.bool_), np.empty(nv))
 
 
 @inline
@@ -136,23 +139,36 @@ def joint_acceleration(dofs, U, Dinv, u, iv, n, acc_i, qdd, t):
             acc_i[r] += dofs[k, r] * qdd[k]
 
 
+@inline
+def finite_where(x, mask, value):
+    """True when ``x[k]`` is finite for every ``k`` with ``mask[k] == value``."""
+    for k in range(x.shape[0]):
+        if mask[k] == value and not np.isfinite(x[k]):
+            return False
+    return True
+
+
 @core
-def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
-    """Forward dynamics of one state into ``qdd`` (nv,). Returns a status (see ``_inputs``):
-    ``i + 1`` when the articulated inertia of body ``i`` is singular."""
+def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
+    """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,) (RBDA section 9.2, see
+    ``hybrid.py``). ``known[k]``: the acceleration of dof ``k`` is given (all dofs of a joint
+    alike); with no dof known this is the ABA. Returns a status (see
+    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular."""
     (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
-     B3, PB, UD, G, t1, t2, Ia) = ws
+     B3, PB, UD, G, t1, t2, Ia, _, _) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
-    if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and tau.shape[0] == nv):
+    if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
+            and tau_known.shape[0] == nv and known.shape[0] == nv):
         return WRONG_SIZE
-    if check and not (finite(q) and finite(v) and finite(tau)):
+    if check and not (finite(q) and finite(v) and finite_where(qdd_known, known, True)
+                      and finite_where(tau_known, known, False)):
         return NONFINITE
     if not placements(ints, body, q, liR, lip, Rj, pj):
         return BAD_QUATERNION
     eps = params[3]
     if fcode > 0:
         world_placements(ints, liR, lip, oR, op)
-    # Pass 1
+    # Pass 1: velocities, velocity-product accelerations (with the known joint accelerations)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if par >= 0:
@@ -166,6 +182,10 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
         for r in range(6):
             vel[i, r] += t1[r]
         motion_cross(vel[i], t1, c[i])
+        if known[iv]:
+            for k in range(iv, iv + n):
+                for r in range(6):
+                    c[i, r] += dofs[k, r] * qdd_known[k]
         theta = body[i, 15:25]
         inertia_matrix(theta, IA[i])
         inertia_mul(theta, vel[i], t1)
@@ -174,18 +194,27 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
             wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
                 pA[i, r] -= t1[r]
-    # Pass 2
+    # Pass 2: articulated inertias, the joints of known acceleration held rigid
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        if known[iv]:
+            if par >= 0:
+                matvec6(IA[i], c[i], t1)
+                for r in range(6):
+                    t2[r] = pA[i, r] + t1[r]
+                congruence_to_parent(liR[i], lip[i], IA[i], B3, PB, IA[par])
+                force_act(liR[i], lip[i], t2, t1)
+                for r in range(6):
+                    pA[par, r] += t1[r]
+            continue
         for k in range(iv, iv + n):
             s = 0.0
             for r in range(6):
                 s += dofs[k, r] * pA[i, r]
-            u[k] = tau[k] - s - friction_torque(dofs, eps, v, k)
+            u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
         if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
-            # Ia = IA - U D^-1 U^T, pa = pA + Ia c + U D^-1 u
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             matvec6(Ia, c[i], t1)
             for r in range(6):
@@ -197,7 +226,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
             force_act(liR[i], lip[i], t2, t1)
             for r in range(6):
                 pA[par, r] += t1[r]
-    # Pass 3
+    # Pass 3: accelerations of the joints of unknown acceleration, forces of the others
     for k in range(6):
         t2[k] = 0.0
     t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
@@ -209,8 +238,30 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
             motion_act_inv(liR[i], lip[i], t2, acc[i])
         for r in range(6):
             acc[i, r] += c[i, r]
+        if known[iv]:
+            matvec6(IA[i], acc[i], t1)
+            for r in range(6):
+                t1[r] += pA[i, r]
+            for k in range(iv, iv + n):
+                qdd[k] = qdd_known[k]
+                s = 0.0
+                for r in range(6):
+                    s += dofs[k, r] * t1[r]
+                tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
+            continue
         joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
-    return result_status(check, finite(qdd))
+        for k in range(iv, iv + n):
+            tau[k] = tau_known[k]
+    return result_status(check, finite(qdd) and finite(tau))
+
+
+@core
+def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
+    """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
+    known acceleration (``ws[21]`` is all False; ``ws[22]`` receives the copy of ``tau``).
+    Returns a status (see ``_inputs``): ``i + 1`` when the articulated inertia of body ``i``
+    is singular."""
+    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[21], fext, fcode, check, qdd, ws[22], ws)
 
 
 @parallel

@@ -17,7 +17,7 @@ from .._jit import inline, kernel, parallel
 from ..joint_kernels import body_placement
 from ..spatial import compose, motion_act
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, finite, finite2, result_status
+from ._inputs import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
 
 
 @inline
