@@ -106,3 +106,16 @@ def test_errors_exit_2_with_a_message(capsys, argv, message):
     code, _, err = run(capsys, *argv)
     assert code == 2
     assert message in err
+
+
+def test_output_piped_into_a_reader_that_stops_early_exits_quietly():
+    """``robodyn demo | true``: no BrokenPipeError traceback, exit status 0."""
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-m", "robodyn.cli", "demo", "pendulum"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE)
+    proc.stdout.close()  # the reader goes away before the output comes
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=300) == 0, err
+    assert "Traceback" not in err

@@ -15,6 +15,7 @@ MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import warnings
 
@@ -184,10 +185,15 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
-            return args.func(args)
+            status = args.func(args)
+        sys.stdout.flush()  # a closed pipe shows here, inside the try
+        return status
     except (ModelError, ValueError) as e:
         print(f"robodyn: error: {e}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader stopped early (``robodyn demo | head``): exit quietly
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":
