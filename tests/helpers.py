@@ -289,3 +289,15 @@ def check_input_validation(call, names, aspect: str) -> None:
 
 
 input_checks = pytest.mark.parametrize("aspect", INPUT_CHECKS)
+
+
+def massless_leaf_model(floating_base: bool = False) -> rd.Model:
+    """An arm with a massless leaf ``finger`` on joint ``knuckle``: its articulated inertia,
+    and so ``M(q)``, is singular."""
+    b = rd.ModelBuilder("leafy")
+    b.add_link("base", mass=1.0, inertia=np.eye(3) * 0.1)
+    b.add_link("arm", mass=1.0, com=(0.2, 0, 0), inertia=np.eye(3) * 0.01)
+    b.add_link("finger")  # no inertial: massless
+    b.add_joint("shoulder", "revolute", "base", "arm", axis=(0, 0, 1))
+    b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
+    return b.build(floating_base=floating_base)

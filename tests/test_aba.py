@@ -8,7 +8,7 @@ import pytest
 
 import robodyn as rd
 from helpers import (F_EXT_FRAMES, assert_rel, check_batch, check_input_validation, input_checks,
-                     random_model, random_models, rng_for, states, with_friction_and_armature)
+                     massless_leaf_model, random_model, random_models, rng_for, states, with_friction_and_armature)
 
 
 @random_models
@@ -50,19 +50,9 @@ def test_solves_the_equation_of_motion(model):
     assert_rel(rd.crba(m, q), rd.crba(model, q) + np.diag(m.armature), 1e-12)
 
 
-def _massless_leaf_model(floating_base: bool) -> rd.Model:
-    b = rd.ModelBuilder("leafy")
-    b.add_link("base", mass=1.0, inertia=np.eye(3) * 0.1)
-    b.add_link("arm", mass=1.0, com=(0.2, 0, 0), inertia=np.eye(3) * 0.01)
-    b.add_link("finger")  # no inertial: massless
-    b.add_joint("shoulder", "revolute", "base", "arm", axis=(0, 0, 1))
-    b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
-    return b.build(floating_base=floating_base)
-
-
 @pytest.mark.parametrize("floating_base", [False, True])
 def test_massless_leaf_is_singular(floating_base):
-    model = _massless_leaf_model(floating_base)
+    model = massless_leaf_model(floating_base)
     q, v, tau = states(model)
     with pytest.raises(ValueError, match=r"body \d+ \('finger', joint 'knuckle'\) is singular"):
         rd.aba(model, q, v, tau)

@@ -10,8 +10,8 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import robodyn as rd
-from helpers import (G, assert_rel, directional_derivative, integrate, pendulum, random_model, rk4, rng_for,
-                     states)
+from helpers import (G, assert_rel, directional_derivative, integrate, massless_leaf_model, pendulum, random_model,
+                     rk4, rng_for, states)
 from robodyn.algorithms.constrained import constraint_jacobian, frame_kinematics
 
 TREES = [random_model(12, seed=11, branching=0.3), random_model(10, seed=12, floating_base=True, branching=0.3)]
@@ -340,13 +340,7 @@ def test_bad_arguments():
 
 def test_singular_mass_matrix():
     """A massless leaf: M is singular, the dynamics is undefined."""
-    b = rd.ModelBuilder("leafy")
-    b.add_link("base")
-    b.add_link("arm", mass=1.0, com=(0.2, 0, 0), inertia=np.eye(3) * 0.01)
-    b.add_link("finger")
-    b.add_joint("shoulder", "revolute", "base", "arm", axis=(0, 0, 1))
-    b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
-    model = b.build()
+    model = massless_leaf_model()
     with pytest.raises(ValueError, match=r"constrained_dynamics: the mass matrix is not positive definite"):
         rd.constrained_dynamics(model, np.zeros(2), np.zeros(2), np.zeros(2),
                                 [rd.PointConstraint("arm", (0, 0, 0), (0, 0, 0))])

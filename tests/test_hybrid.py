@@ -9,8 +9,8 @@ import pinocchio as pin
 import pytest
 
 import robodyn as rd
-from helpers import (F_EXT_FRAMES, PLANAR_2R, assert_rel, planar_2r, planar_2r_terms, random_models, rng_for,
-                     states, with_friction_and_armature)
+from helpers import (F_EXT_FRAMES, PLANAR_2R, assert_rel, massless_leaf_model, planar_2r, planar_2r_terms,
+                     random_models, rng_for, states, with_friction_and_armature)
 from robodyn import joints as J
 from urdf_subset import load_pair, pairs
 
@@ -135,18 +135,8 @@ def test_batch_matches_single_states():
     assert_rel(a_out[2], rd.hybrid_dynamics(model, q[0, 0], v[0, 2], a[0, 0], tau[0, 0], mask)[0], 1e-12)
 
 
-def _massless_leaf_model() -> rd.Model:
-    b = rd.ModelBuilder("leafy")
-    b.add_link("base")
-    b.add_link("arm", mass=1.0, com=(0.2, 0, 0), inertia=np.eye(3) * 0.01)
-    b.add_link("finger")
-    b.add_joint("shoulder", "revolute", "base", "arm", axis=(0, 0, 1))
-    b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
-    return b.build()
-
-
 def test_singular_body_only_when_its_acceleration_is_unknown():
-    model = _massless_leaf_model()
+    model = massless_leaf_model()
     q, v = np.array([0.3, 0.2]), np.array([0.5, -1.0])
     with pytest.raises(ValueError, match=r"hybrid_dynamics: the articulated inertia of body 1 \('finger', joint "
                                          r"'knuckle'\) is singular.*prescribe the acceleration"):

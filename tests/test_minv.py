@@ -9,8 +9,8 @@ import pinocchio as pin
 import pytest
 
 import robodyn as rd
-from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, planar_2r,
-                     planar_2r_terms, random_models, rng_for, states)
+from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, massless_leaf_model,
+                     planar_2r, planar_2r_terms, random_models, rng_for, states)
 from urdf_subset import load_pair, pairs
 
 
@@ -73,13 +73,7 @@ def test_input_validation(aspect):
 
 
 def test_singular_model():
-    b = rd.ModelBuilder("leafy")
-    b.add_link("base")
-    b.add_link("arm", mass=1.0, com=(0.2, 0, 0), inertia=np.eye(3) * 0.01)
-    b.add_link("finger")
-    b.add_joint("shoulder", "revolute", "base", "arm", axis=(0, 0, 1))
-    b.add_joint("knuckle", "revolute", "arm", "finger", xyz=(0.4, 0, 0), axis=(0, 1, 0))
-    model = b.build()
+    model = massless_leaf_model()
     with pytest.raises(ValueError, match=r"inverse_mass_matrix: the articulated inertia of body 1 \('finger', "
                                          r"joint 'knuckle'\) is singular, so M\(q\) is singular"):
         rd.inverse_mass_matrix(model, np.zeros(2))

@@ -93,6 +93,21 @@ def _reference(model, reference):
     return reference
 
 
+class Tracking(Controller):
+    """A controller that tracks a joint reference ``t -> (q_d, qd_d, qdd_d)``."""
+
+    def __init__(self, model, reference):
+        super().__init__(model)
+        self.reference = _reference(model, reference)
+
+    def desired(self, t):
+        return self.reference(t)
+
+    @property
+    def vectorized(self):
+        return isinstance(self.reference, (PointToPoint, Sampled))
+
+
 class PDGravity(Controller):
     """PD control with gravity compensation to a set point ``q_desired``:
     ``tau = Kp (q_d - q) - Kd qd + g(q)``. With the exact gravity the set point is globally
@@ -161,7 +176,7 @@ class PIDGravity(PDGravity):
         return self.torque(t, q, v, self.state0)
 
 
-class ComputedTorque(Controller):
+class ComputedTorque(Tracking):
     """Inverse-dynamics (computed-torque) control on a reference ``t -> (q_d, qd_d, qdd_d)``:
     ``tau = rnea(q, qd, qdd_d + Kd ed + Kp e)`` (the model's friction and armature
     included). With the exact model the error obeys ``e'' + Kd e' + Kp e = 0``: each joint
@@ -169,8 +184,7 @@ class ComputedTorque(Controller):
     ``V = ed^T ed / 2 + e^T Kp e / 2`` has ``dV/dt = -ed^T Kd ed``. Spong et al., section 8.3."""
 
     def __init__(self, model, reference, kp, kd):
-        super().__init__(model)
-        self.reference = _reference(model, reference)
+        super().__init__(model, reference)
         self.kp, self.kd = gain("kp", kp, model.nv), gain("kd", kd, model.nv)
 
     def __call__(self, t, q, v):
@@ -185,13 +199,6 @@ class ComputedTorque(Controller):
 
         breaks, coefs = piecewise()
         return COMPUTED_TORQUE, np.stack([self.kp, self.kd]), breaks, coefs
-
-    def desired(self, t):
-        return self.reference(t)
-
-    @property
-    def vectorized(self):
-        return isinstance(self.reference, (PointToPoint, Sampled))
 
     def lyapunov(self, t, q, v):
         q_d, v_d, _ = self.reference(t)
@@ -244,7 +251,7 @@ class TaskSpacePD(Controller):
         return 0.5 * v @ crba(self.model, q) @ v + 0.5 * ex @ (self.kp * ex)
 
 
-class SlotineLi(Controller):
+class SlotineLi(Tracking):
     """Passivity-based tracking control (Slotine and Li, 1987) on a reference.
 
     With ``q~ = q - q_d``, the reference velocity ``qd_r = qd_d - Lambda q~``, its derivative
@@ -261,8 +268,7 @@ class SlotineLi(Controller):
     """
 
     def __init__(self, model, reference, lam, kd):
-        super().__init__(model)
-        self.reference = _reference(model, reference)
+        super().__init__(model, reference)
         self.lam, self.kd = gain("lam", lam, model.nv), gain("kd", kd, model.nv)
 
     def sliding(self, t, q, v):
@@ -280,13 +286,6 @@ class SlotineLi(Controller):
     def __call__(self, t, q, v):
         _, v_r, a_r, s = self.sliding(t, q, v)
         return self.feedforward(q, v, v_r, a_r) - self.kd * s
-
-    def desired(self, t):
-        return self.reference(t)
-
-    @property
-    def vectorized(self):
-        return isinstance(self.reference, (PointToPoint, Sampled))
 
     def lyapunov(self, t, q, v):
         e, _, _, s = self.sliding(t, q, v)
