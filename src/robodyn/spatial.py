@@ -210,34 +210,13 @@ def inertia_act(R, p, theta, out):
 def inertia_matrix(theta, out):
     """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters."""
     mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
-    for r in range(6):
-        for c in range(6):
-            out[r, c] = 0.0
-    out[0, 0] = mass
-    out[1, 1] = mass
-    out[2, 2] = mass
-    # upper-right block: -[h]x ; lower-left: [h]x
-    out[0, 4] = hz
-    out[0, 5] = -hy
-    out[1, 3] = -hz
-    out[1, 5] = hx
-    out[2, 3] = hy
-    out[2, 4] = -hx
-    out[4, 0] = hz
-    out[5, 0] = -hy
-    out[3, 1] = -hz
-    out[5, 1] = hx
-    out[3, 2] = hy
-    out[4, 2] = -hx
-    out[3, 3] = theta[4]
-    out[3, 4] = theta[5]
-    out[4, 3] = theta[5]
-    out[4, 4] = theta[6]
-    out[3, 5] = theta[7]
-    out[5, 3] = theta[7]
-    out[4, 5] = theta[8]
-    out[5, 4] = theta[8]
-    out[5, 5] = theta[9]
+    # rows 0-2: [m 1, -[h]x]; rows 3-5: [[h]x, I_o]
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3], out[0, 4], out[0, 5] = mass, 0.0, 0.0, 0.0, hz, -hy
+    out[1, 0], out[1, 1], out[1, 2], out[1, 3], out[1, 4], out[1, 5] = 0.0, mass, 0.0, -hz, 0.0, hx
+    out[2, 0], out[2, 1], out[2, 2], out[2, 3], out[2, 4], out[2, 5] = 0.0, 0.0, mass, hy, -hx, 0.0
+    out[3, 0], out[3, 1], out[3, 2], out[3, 3], out[3, 4], out[3, 5] = 0.0, -hz, hy, theta[4], theta[5], theta[7]
+    out[4, 0], out[4, 1], out[4, 2], out[4, 3], out[4, 4], out[4, 5] = hz, 0.0, -hx, theta[5], theta[6], theta[8]
+    out[5, 0], out[5, 1], out[5, 2], out[5, 3], out[5, 4], out[5, 5] = -hy, hx, 0.0, theta[7], theta[8], theta[9]
 
 
 @inline
@@ -340,6 +319,27 @@ def motion_cross_matrix(m, out):
     out[1, 5] = -v0
     out[2, 3] = -v1
     out[2, 4] = v0
+
+
+@inline
+def wrench_to_world(frame, R, p, f, out):
+    """A wrench ``[force; torque]`` given in ``frame`` expressed in world coordinates (world
+    axes, torque about the world origin); ``(R, p)`` is the body's world placement.
+
+    ``frame`` 0: body frame; 1: already in world coordinates; 2: world axes, torque about the
+    body origin (``n_0 = n + p x f``).
+    """
+    if frame == 0:
+        force_act(R, p, f, out)
+    elif frame == 1:
+        for k in range(6):
+            out[k] = f[k]
+    else:
+        for k in range(3):
+            out[k] = f[k]
+        out[3] = f[3] + p[1] * f[2] - p[2] * f[1]
+        out[4] = f[4] + p[2] * f[0] - p[0] * f[2]
+        out[5] = f[5] + p[0] * f[1] - p[1] * f[0]
 
 
 @inline

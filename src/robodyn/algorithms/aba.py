@@ -2,16 +2,19 @@
 
     a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)
 
-Pass 1 (root to leaves): ``v_i = iX_p v_p + S_i qd_i``, ``c_i = v_i x S_i qd_i``,
-``IA_i = I_i``, ``pA_i = v_i x* I_i v_i - f_ext_i``.
+Every spatial quantity is expressed in world coordinates (Pinocchio's choice since 2.x):
+articulated inertias then pass to the parent and accelerations to the child without a
+change of frame. ``oS_i`` are the joint's motion-subspace columns in the world frame.
 
-Pass 2 (leaves to root): ``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``,
-``u_i = tau_i - S_i^T pA_i (- friction)``; the articulated inertia
-``Ia = IA_i - U_i D_i^-1 U_i^T`` and bias ``pa = pA_i + Ia c_i + U_i D_i^-1 u_i`` are added to
-the parent: ``IA_p += iX_p^T Ia iX_p``, ``pA_p += iX_p^T pa``.
+Pass 1 (root to leaves): ``v_i = v_p + oS_i qd_i``, ``c_i = v_i x oS_i qd_i``,
+``IA_i = oI_i`` (the body inertia in world coordinates), ``pA_i = v_i x* IA_i v_i - f_ext_i``.
 
-Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = iX_p a_p + c_i``,
-``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + S_i qdd_i``.
+Pass 2 (leaves to root): ``U_i = IA_i oS_i``, ``D_i = oS_i^T U_i (+ armature)``,
+``u_i = tau_i - oS_i^T pA_i (- friction)``; the parent receives
+``IA_p += IA_i - U_i D_i^-1 U_i^T`` and ``pA_p += pA_i + IA_i c_i + U_i D_i^-1 (u_i - U_i^T c_i)``.
+
+Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = a_p + c_i``,
+``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + oS_i qdd_i``.
 
 A body whose ``D_i`` is singular (a massless leaf, a point mass on its joint axis) makes the
 forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
@@ -26,12 +29,12 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, inline, kernel, parallel
-from ..joint_kernels import friction_torque
-from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul,
-                       matvec6, motion_act_inv, motion_cross, wrench_to_local)
+from ..joint_kernels import body_placement, friction_torque
+from ..spatial import (force_cross, inertia_act, inertia_matrix, inertia_mul, matvec6, motion_act, motion_cross,
+                       wrench_to_world)
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
-from .kinematics import placements, world_placements
+from .kinematics import world_placement
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -40,10 +43,10 @@ SINGULAR_RTOL = 1e-12
 @kernel
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6, 6)), np.empty((nb, 6)),
-            np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)), np.empty(nv), np.empty((3, 3)),
-            np.empty(3), np.empty((3, 3, 3)), np.empty((3, 3)), np.empty((6, 6)), np.empty((6, 12)),
-            np.empty(6), np.empty(6), np.empty((6, 6)), np.zeros(nv, dtype=np.bool_), np.empty(nv))
+            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 6)), np.empty((nb, 6)),
+            np.empty((nb, 6, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)),
+            np.empty(nv), np.empty((6, 6)), np.empty((6, 12)), np.empty(10), np.empty(6), np.empty(6),
+            np.empty(0), np.zeros(nv, dtype=np.bool_), np.empty(nv))
 
 
 @inline
@@ -82,19 +85,20 @@ def invert_block(Dinv, iv, n, G, tol):
 
 
 @inline
-def joint_inertia(IA_i, dofs, iv, n, U, Dinv, G):
+def joint_inertia(IA_i, S, dofs, iv, n, U, Dinv, G):
     """``U_k = IA_i S_k`` (rows ``iv..iv+n`` of ``U``) and ``D^-1 = (S^T IA_i S + armature)^-1``
-    (rows ``iv..iv+n`` of ``Dinv``) for one joint. Returns False when ``D`` is singular: a
-    pivot below ``SINGULAR_RTOL`` times the scale of ``IA_i`` (NaN input propagates)."""
+    (rows ``iv..iv+n`` of ``Dinv``) for one joint, with ``S_k = S[k, :6]`` in the frame of
+    ``IA_i`` and the armature in ``dofs[k, 6]``. Returns False when ``D`` is singular: a pivot
+    below ``SINGULAR_RTOL`` times the scale of ``IA_i`` (NaN input propagates)."""
     scale = 0.0
     for r in range(6):
         scale += abs(IA_i[r, r])
     for k in range(iv, iv + n):
-        matvec6(IA_i, dofs[k, :6], U[k])
+        matvec6(IA_i, S[k, :6], U[k])
         for j in range(iv, iv + n):
             d = 0.0
             for r in range(6):
-                d += dofs[j, r] * U[k, r]
+                d += S[j, r] * U[k, r]
             Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
     if n == 1:  # the common case: D is a scalar
         if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
@@ -105,14 +109,20 @@ def joint_inertia(IA_i, dofs, iv, n, U, Dinv, G):
 
 
 @inline
-def articulated_inertia(IA_i, U, Dinv, iv, n, UD, Ia):
-    """``UD = U D^-1`` (6 x n) and the inertia passed to the parent, ``Ia = IA_i - UD U^T``."""
+def gain(U, Dinv, iv, n, UD):
+    """``UD = U D^-1`` (6 x n) for the joint whose dofs are ``iv..iv+n``."""
     for r in range(6):
         for j in range(n):
             s = 0.0
             for k in range(n):
                 s += U[iv + k, r] * Dinv[iv + k, j]
             UD[r, j] = s
+
+
+@inline
+def articulated_inertia(IA_i, U, Dinv, iv, n, UD, Ia):
+    """``UD = U D^-1`` (6 x n) and the inertia passed to the parent, ``Ia = IA_i - UD U^T``."""
+    gain(U, Dinv, iv, n, UD)
     for r in range(6):
         for cc in range(6):
             s = IA_i[r, cc]
@@ -122,7 +132,21 @@ def articulated_inertia(IA_i, U, Dinv, iv, n, UD, Ia):
 
 
 @inline
-def joint_acceleration(dofs, U, Dinv, u, iv, n, acc_i, qdd, t):
+def add_articulated_inertia(IA_i, U, UD, iv, n, IA_p):
+    """``IA_p += IA_i - UD U^T`` (all in one frame), computed on the upper triangle and
+    mirrored, so that ``IA_p`` stays exactly symmetric."""
+    for r in range(6):
+        for cc in range(r, 6):
+            s = IA_i[r, cc]
+            for j in range(n):
+                s -= UD[r, j] * U[iv + j, cc]
+            IA_p[r, cc] += s
+            if cc != r:
+                IA_p[cc, r] += s
+
+
+@inline
+def joint_acceleration(S, U, Dinv, u, iv, n, acc_i, qdd, t):
     """``qdd = D^-1 (u - U^T a_i)`` for one joint, then ``a_i += S qdd`` (``t`` (6,) scratch)."""
     for k in range(iv, iv + n):
         s = 0.0
@@ -136,7 +160,46 @@ def joint_acceleration(dofs, U, Dinv, u, iv, n, acc_i, qdd, t):
         qdd[j] = s
     for k in range(iv, iv + n):
         for r in range(6):
-            acc_i[r] += dofs[k, r] * qdd[k]
+            acc_i[r] += S[k, r] * qdd[k]
+
+
+@inline
+def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, par, IA, pA):
+    """Pass 2 of the ABA for a joint of one dof ``iv`` (the common case, written out):
+    ``U = IA_i S``, ``D = S^T U + armature``, ``u = tau_f - S^T pA_i`` (``tau_f``: the joint
+    force less friction), then, unless the body is a root, ``IA_p += IA_i - U U^T / D`` and
+    ``pA_p += pA_i + IA_i c_i + U (u - U^T c_i) / D``. ``t`` (6,) is scratch. Returns False
+    when ``D`` is singular (see :func:`joint_inertia`)."""
+    s0, s1, s2, s3, s4, s5 = S[0], S[1], S[2], S[3], S[4], S[5]
+    c0, c1, c2, c3, c4, c5 = c_i[0], c_i[1], c_i[2], c_i[3], c_i[4], c_i[5]
+    D, Uc, scale = armature, 0.0, 0.0
+    for r in range(6):
+        a0, a1, a2, a3, a4, a5 = IA_i[r, 0], IA_i[r, 1], IA_i[r, 2], IA_i[r, 3], IA_i[r, 4], IA_i[r, 5]
+        ur = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3 + a4 * s4 + a5 * s5
+        U_k[r] = ur
+        t[r] = a0 * c0 + a1 * c1 + a2 * c2 + a3 * c3 + a4 * c4 + a5 * c5
+        D += S[r] * ur
+        Uc += ur * c_i[r]
+        scale += abs(IA_i[r, r])
+    if abs(D) <= SINGULAR_RTOL * scale:
+        return False
+    dinv = 1.0 / D
+    Dinv[iv, 0] = dinv
+    uk = tau_f - (s0 * pA_i[0] + s1 * pA_i[1] + s2 * pA_i[2] + s3 * pA_i[3] + s4 * pA_i[4] + s5 * pA_i[5])
+    u[iv] = uk
+    if par < 0:
+        return True
+    uh = (uk - Uc) * dinv
+    for r in range(6):
+        pA[par, r] += pA_i[r] + t[r] + U_k[r] * uh
+    for r in range(6):
+        ud = U_k[r] * dinv
+        for cc in range(r, 6):
+            x = IA_i[r, cc] - ud * U_k[cc]
+            IA[par, r, cc] += x
+            if cc != r:
+                IA[par, cc, r] += x
+    return True
 
 
 @inline
@@ -153,9 +216,15 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
     """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,) (RBDA section 9.2, see
     ``hybrid.py``). ``known[k]``: the acceleration of dof ``k`` is given (all dofs of a joint
     alike); with no dof known this is the ABA. Returns a status (see
-    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular."""
-    (liR, lip, oR, op, vel, c, IA, pA, acc, U, Dinv, u, Rj, pj,
-     B3, PB, UD, G, t1, t2, Ia, _, _) = ws
+    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
+
+    Every spatial quantity is in world coordinates, where articulated inertias and bias
+    forces pass to the parent without a change of frame (``IA_p += Ia``, ``pA_p += pa``) and
+    accelerations to the child likewise (``a_i = a_p + c_i``); ``oS`` are the world-frame
+    motion-subspace columns and ``c_i = v_i x oS_i qd_i`` (RBDA section 7.3 with every
+    coordinate transform the identity; Carpentier and Mansard 2018)."""
+    (liR, lip, oR, op, Rj, pj, oS, vel, c, IA, pA, acc, U, Dinv, u,
+     UD, G, Iw, t1, t2, _, _, _) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
             and tau_known.shape[0] == nv and known.shape[0] == nv):
@@ -163,35 +232,34 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
     if check and not (finite(q) and finite(v) and finite_where(qdd_known, known, True)
                       and finite_where(tau_known, known, False)):
         return NONFINITE
-    if not placements(ints, body, q, liR, lip, Rj, pj):
-        return BAD_QUATERNION
     eps = params[3]
-    if fcode > 0:
-        world_placements(ints, liR, lip, oR, op)
-    # Pass 1: velocities, velocity-product accelerations (with the known joint accelerations)
+    # Pass 1: placements, velocities, velocity-product accelerations (with the known joint
+    # accelerations), rigid-body inertias and bias forces
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if par >= 0:
-            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
-        else:
-            vel[i, :] = 0.0
-        t1[:] = 0.0
+        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+            return BAD_QUATERNION
+        world_placement(i, par, liR, lip, oR, op)
+        for k in range(iv, iv + n):
+            motion_act(oR[i], op[i], dofs[k, :6], oS[k])
+        for r in range(6):
+            t1[r] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
-                t1[r] += dofs[k, r] * v[k]
+                t1[r] += oS[k, r] * v[k]
         for r in range(6):
-            vel[i, r] += t1[r]
+            vel[i, r] = t1[r] + (vel[par, r] if par >= 0 else 0.0)
         motion_cross(vel[i], t1, c[i])
         if known[iv]:
             for k in range(iv, iv + n):
                 for r in range(6):
-                    c[i, r] += dofs[k, r] * qdd_known[k]
-        theta = body[i, 15:25]
-        inertia_matrix(theta, IA[i])
-        inertia_mul(theta, vel[i], t1)
+                    c[i, r] += oS[k, r] * qdd_known[k]
+        inertia_act(oR[i], op[i], body[i, 15:25], Iw)
+        inertia_matrix(Iw, IA[i])
+        inertia_mul(Iw, vel[i], t1)
         force_cross(vel[i], t1, pA[i])
         if fcode >= 0:
-            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
+            wrench_to_world(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
                 pA[i, r] -= t1[r]
     # Pass 2: articulated inertias, the joints of known acceleration held rigid
@@ -201,43 +269,46 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
             if par >= 0:
                 matvec6(IA[i], c[i], t1)
                 for r in range(6):
-                    t2[r] = pA[i, r] + t1[r]
-                congruence_to_parent(liR[i], lip[i], IA[i], B3, PB, IA[par])
-                force_act(liR[i], lip[i], t2, t1)
-                for r in range(6):
-                    pA[par, r] += t1[r]
+                    pA[par, r] += pA[i, r] + t1[r]
+                    for cc in range(6):
+                        IA[par, r, cc] += IA[i, r, cc]
+            continue
+        if n == 1:
+            if not articulate_single_dof(IA[i], oS[iv], dofs[iv, 6], c[i], pA[i],
+                                         tau_known[iv] - friction_torque(dofs, eps, v, iv),
+                                         iv, U[iv], Dinv, u, t1, par, IA, pA):
+                return i + 1
             continue
         for k in range(iv, iv + n):
             s = 0.0
             for r in range(6):
-                s += dofs[k, r] * pA[i, r]
+                s += oS[k, r] * pA[i, r]
             u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
-        if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
+        if not joint_inertia(IA[i], oS, dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
-            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
-            matvec6(Ia, c[i], t1)
+            # pa = pA + Ia c + U D^-1 u = pA + IA c + U D^-1 (u - U^T c)
+            gain(U, Dinv, iv, n, UD)
+            for k in range(iv, iv + n):
+                s = 0.0
+                for r in range(6):
+                    s += U[k, r] * c[i, r]
+                t2[k - iv] = u[k] - s
+            matvec6(IA[i], c[i], t1)
             for r in range(6):
                 s = pA[i, r] + t1[r]
                 for j in range(n):
-                    s += UD[r, j] * u[iv + j]
-                t2[r] = s
-            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
-            force_act(liR[i], lip[i], t2, t1)
-            for r in range(6):
-                pA[par, r] += t1[r]
+                    s += UD[r, j] * t2[j]
+                pA[par, r] += s
+            add_articulated_inertia(IA[i], U, UD, iv, n, IA[par])
     # Pass 3: accelerations of the joints of unknown acceleration, forces of the others
     for k in range(6):
         t2[k] = 0.0
     t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if par >= 0:
-            motion_act_inv(liR[i], lip[i], acc[par], acc[i])
-        else:
-            motion_act_inv(liR[i], lip[i], t2, acc[i])
         for r in range(6):
-            acc[i, r] += c[i, r]
+            acc[i, r] = (acc[par, r] if par >= 0 else t2[r]) + c[i, r]
         if known[iv]:
             matvec6(IA[i], acc[i], t1)
             for r in range(6):
@@ -246,10 +317,18 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
                 qdd[k] = qdd_known[k]
                 s = 0.0
                 for r in range(6):
-                    s += dofs[k, r] * t1[r]
+                    s += oS[k, r] * t1[r]
                 tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
             continue
-        joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
+        if n == 1:
+            s = 0.0
+            for r in range(6):
+                s += U[iv, r] * acc[i, r]
+            qdd[iv] = Dinv[iv, 0] * (u[iv] - s)
+            for r in range(6):
+                acc[i, r] += oS[iv, r] * qdd[iv]
+        else:
+            joint_acceleration(oS, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):
             tau[k] = tau_known[k]
     return result_status(check, finite(qdd) and finite(tau))

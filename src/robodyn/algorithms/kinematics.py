@@ -33,17 +33,23 @@ def placements(ints, body, q, liR, lip, Rj, pj):
 
 
 @inline
+def world_placement(i, par, liR, lip, oR, op):
+    """``oR[i], op[i]``: placement of body ``i`` in the world, from its local placement and
+    the world placement of its parent ``par`` (``-1``: the world)."""
+    if par < 0:
+        for r in range(3):
+            op[i, r] = lip[i, r]
+            for c in range(3):
+                oR[i, r, c] = liR[i, r, c]
+    else:
+        compose(oR[par], op[par], liR[i], lip[i], oR[i], op[i])
+
+
+@inline
 def world_placements(ints, liR, lip, oR, op):
     """``oR[i], op[i]``: placement of body ``i`` in the world from the local placements."""
     for i in range(ints.shape[0]):
-        par = ints[i, 0]
-        if par < 0:
-            for r in range(3):
-                op[i, r] = lip[i, r]
-                for c in range(3):
-                    oR[i, r, c] = liR[i, r, c]
-        else:
-            compose(oR[par], op[par], liR[i], lip[i], oR[i], op[i])
+        world_placement(i, ints[i, 0], liR, lip, oR, op)
 
 
 @inline

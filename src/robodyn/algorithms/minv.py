@@ -67,7 +67,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                 for r in range(6):
                     s += dofs[k, r] * F[i, r, col]
                 Minv[k, col] = (1.0 if col == k else 0.0) - s
-        if not joint_inertia(IA[i], dofs, iv, n, U, Dinv, G):
+        if not joint_inertia(IA[i], dofs, dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
