@@ -8,6 +8,13 @@ otherwise add atomic increments and decrements of every array passed to a helper
 several-fold slowdown of the inner loops). They must not allocate: workspaces come from
 their callers.
 
+``fast(*argtypes)``: a single-state entry point compiled for exactly one argument signature
+(C-contiguous float64 arrays ``VEC``/``MAT`` for the state and the output, the model's
+read-only ``MODEL_INTS``/``MODEL_PACKED`` arrays, a ``bool``). Compilation happens (or the
+cache is loaded) when the module defining it is imported, and the dispatcher compiles nothing
+else: any other argument types (lists, integers, strided or read-only arrays, batches) raise
+``TypeError``, on which the public function takes its general path.
+
 All release the GIL (``nogil``), so Python threads run them concurrently (they share no
 state: every call allocates its own workspace). ``error_model="numpy"`` lets divisions by zero give inf/nan instead of raising (the kernels
 check their inputs and pivots themselves); ``fastmath`` allows fused multiply-add and
@@ -15,6 +22,7 @@ reassociation but keeps NaN/Inf semantics, so the finiteness checks stay exact.
 """
 
 from numba import njit
+from numba import types as _types
 
 FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 _BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH, nogil=True)
@@ -23,3 +31,14 @@ kernel = njit(**_BASE)
 parallel = njit(parallel=True, **_BASE)
 core = njit(_nrt=False, **_BASE)
 inline = njit(inline="always", _nrt=False, **_BASE)
+
+
+VEC = _types.Array(_types.float64, 1, "C")
+MAT = _types.Array(_types.float64, 2, "C")
+MODEL_INTS = _types.Array(_types.int64, 2, "C", readonly=True)
+MODEL_PACKED = _types.Array(_types.float64, 1, "C", readonly=True)
+
+
+def fast(*argtypes):
+    """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only."""
+    return njit([_types.int64(*argtypes)], **_BASE)

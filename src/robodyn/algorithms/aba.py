@@ -26,13 +26,14 @@ used by ``hybrid.py``): the ABA is its case with no joint of known acceleration.
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
+from numba import boolean, prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
 from ..spatial import (force_cross, inertia_act, inertia_matrix, inertia_mul, matvec6, motion_act, motion_cross,
                        wrench_to_world)
 from . import _inputs
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import world_placement
 
@@ -42,11 +43,27 @@ SINGULAR_RTOL = 1e-12
 
 @kernel
 def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 6)), np.empty((nb, 6)),
-            np.empty((nb, 6, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nv, 6)), np.empty((nv, 6)),
-            np.empty(nv), np.empty((6, 6)), np.empty((6, 12)), np.empty(10), np.empty(6), np.empty(6),
-            np.empty(0), np.zeros(nv, dtype=np.bool_), np.empty(nv))
+    """Scratch of :func:`hybrid_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, vel, c, IA, pA, acc,
+    U, Dinv, u, UD, G, Iw, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy of
+    the joint forces and ``known`` is all False (no joint of known acceleration)."""
+    buf = np.empty((POSES_SIZE_NB + 60) * nb + 20 * nv + POSES_SIZE + 130)
+    P, o = poses(buf, 0, nb)
+    oS, o = take(buf, o, (nv, 6))
+    vel, o = take(buf, o, (nb, 6))
+    c, o = take(buf, o, (nb, 6))
+    IA, o = take(buf, o, (nb, 6, 6))
+    pA, o = take(buf, o, (nb, 6))
+    acc, o = take(buf, o, (nb, 6))
+    U, o = take(buf, o, (nv, 6))
+    Dinv, o = take(buf, o, (nv, 6))
+    u, o = take(buf, o, (nv,))
+    UD, o = take(buf, o, (6, 6))
+    G, o = take(buf, o, (6, 12))
+    Iw, o = take(buf, o, (10,))
+    t1, o = take(buf, o, (6,))
+    t2, o = take(buf, o, (6,))
+    tau, o = take(buf, o, (nv,))
+    return buf, P, oS, vel, c, IA, pA, acc, U, Dinv, u, UD, G, Iw, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
 
 
 @inline
@@ -223,8 +240,7 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
     accelerations to the child likewise (``a_i = a_p + c_i``); ``oS`` are the world-frame
     motion-subspace columns and ``c_i = v_i x oS_i qd_i`` (RBDA section 7.3 with every
     coordinate transform the identity; Carpentier and Mansard 2018)."""
-    (liR, lip, oR, op, Rj, pj, oS, vel, c, IA, pA, acc, U, Dinv, u,
-     UD, G, Iw, t1, t2, _, _, _) = ws
+    _, (liR, lip, oR, op, Rj, pj), oS, vel, c, IA, pA, acc, U, Dinv, u, UD, G, Iw, t1, t2, _, _ = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
             and tau_known.shape[0] == nv and known.shape[0] == nv):
@@ -337,10 +353,10 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
 @core
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
-    known acceleration (``ws[21]`` is all False; ``ws[22]`` receives the copy of ``tau``).
+    known acceleration (``ws[17]`` is all False; ``ws[16]`` receives the copy of ``tau``).
     Returns a status (see ``_inputs``): ``i + 1`` when the articulated inertia of body ``i``
     is singular."""
-    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[21], fext, fcode, check, qdd, ws[22], ws)
+    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[17], fext, fcode, check, qdd, ws[16], ws)
 
 
 @parallel
@@ -359,7 +375,7 @@ def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
                    workspace(ints.shape[0], dofs.shape[0]))
 
 
-@kernel
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
 def _aba_packed(ints, packed, q, v, tau, check, qdd):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
@@ -383,10 +399,13 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
     """
     k = model._kernel
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, tau):
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
         qdd = np.empty(model.nv)  # fast path for one state: the kernel checks sizes and values
-        if _aba_packed(k["ints"], k["packed"][bool(friction), bool(armature)], q, v, tau, check_finite, qdd) == OK:
-            return qdd
+        try:
+            if _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite, qdd) == OK:
+                return qdd
+        except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
+            pass
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]

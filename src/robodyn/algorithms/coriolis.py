@@ -22,22 +22,35 @@ of the first kind ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``.
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
+from numba import boolean, prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .crba import world_inertias
-from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
+from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
 from .kinematics import poses_checked, world_motion_subspace
 
 
 @kernel
 def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nv, 6)), np.empty((nb, 10)),
-            np.empty((nb, 6, 6)), np.empty((nb, 6)), np.empty((6, 6)), np.empty((6, 6)), np.empty(6),
-            np.empty(6), np.empty(6), np.empty(6))
+    """Scratch of :func:`coriolis_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, oSd, Ic, Bc, oV, K,
+    Vx, F1, F2, F3, h)``."""
+    buf = np.empty((POSES_SIZE_NB + 52) * nb + 12 * nv + POSES_SIZE + 96)
+    P, o = poses(buf, 0, nb)
+    oS, o = take(buf, o, (nv, 6))
+    oSd, o = take(buf, o, (nv, 6))
+    Ic, o = take(buf, o, (nb, 10))
+    Bc, o = take(buf, o, (nb, 6, 6))
+    oV, o = take(buf, o, (nb, 6))
+    K, o = take(buf, o, (6, 6))
+    Vx, o = take(buf, o, (6, 6))
+    F1, o = take(buf, o, (6,))
+    F2, o = take(buf, o, (6,))
+    F3, o = take(buf, o, (6,))
+    h, o = take(buf, o, (6,))
+    return buf, P, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h
 
 
 @inline
@@ -69,7 +82,7 @@ def body_B(theta, V, K, Vx, h, B):
 
 @core
 def coriolis_one(ints, body, dofs, q, v, check, C, ws):
-    liR, lip, oR, op, Rj, pj, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
+    _, (liR, lip, oR, op, Rj, pj), oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == dofs.shape[0]):
         return WRONG_SIZE
@@ -129,6 +142,13 @@ def _coriolis_single(ints, body, dofs, q, v, check, C):
     return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 
 
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, boolean, MAT)
+def _coriolis_packed(ints, packed, q, v, check, C):
+    """One state, the model in one array (the fast path)."""
+    body, dofs, _, _ = unpack(ints, packed)
+    return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
+
+
 def _run(model, batch, x, check, what):
     k = model._kernel
     dofs, q, v = k["dofs"][(False, False)], x["q"], x["v"]
@@ -150,11 +170,13 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     ``Mdot - 2C`` is skew-symmetric and ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel
     symbols of :func:`christoffel_symbols`. Reference: Echeandia and Wensing (2021).
     """
-    if _inputs.vectors(q, v):
-        k = model._kernel  # fast path for one state: the kernel checks sizes and values
-        C = np.empty((model.nv, model.nv))
-        if _coriolis_single(k["ints"], k["body"], k["dofs"][False, False], q, v, check_finite, C) == OK:
+    k = model._kernel  # fast path for one state: the kernel checks sizes and values
+    C = np.empty((model.nv, model.nv))
+    try:
+        if _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
             return C
+    except TypeError:  # not contiguous float64 vectors
+        pass
     batch, x = _inputs.states(model, q=q, v=v)
     return _inputs.unflatten(_run(model, batch, x, check_finite, "coriolis_matrix"), batch)
 

@@ -14,19 +14,25 @@ Returns the full symmetric matrix.
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
+from numba import boolean, prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
-from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
+from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
 from .kinematics import poses_checked, world_motion_subspace
 
 
 @kernel
 def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)), np.empty(6))
+    """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
+    buf = np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6)
+    P, o = poses(buf, 0, nb)
+    oS, o = take(buf, o, (nv, 6))
+    Ic, o = take(buf, o, (nb, 10))
+    F, o = take(buf, o, (6,))
+    return buf, P, oS, Ic, F
 
 
 @inline
@@ -38,7 +44,7 @@ def world_inertias(ints, body, oR, op, Ic):
 
 @core
 def crba_one(ints, body, dofs, q, check, M, ws):
-    liR, lip, oR, op, Rj, pj, oS, Ic, F = ws
+    _, (liR, lip, oR, op, Rj, pj), oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
     status = poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
@@ -79,6 +85,13 @@ def _crba_single(ints, body, dofs, q, check, M):
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
+@fast(MODEL_INTS, MODEL_PACKED, VEC, boolean, MAT)
+def _crba_packed(ints, packed, q, check, M):
+    """One state, the model in one array (the fast path)."""
+    body, dofs, _, _ = unpack(ints, packed)
+    return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
+
+
 def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Joint-space inertia (mass) matrix ``M(q)``, full and symmetric.
 
@@ -89,10 +102,12 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.nd
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
     k = model._kernel
-    if _inputs.vectors(q):
-        M = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
-        if _crba_single(k["ints"], k["body"], k["dofs"][False, bool(armature)], q, check_finite, M) == OK:
+    M = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
+    try:
+        if _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
             return M
+    except (TypeError, KeyError):  # not a contiguous float64 vector (or armature not bool)
+        pass
     batch, x = _inputs.states(model, q=q)
     dofs, q = k["dofs"][(False, bool(armature))], x["q"]
     if batch == ():

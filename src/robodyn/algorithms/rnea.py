@@ -17,21 +17,29 @@ Pass 2 (leaves to root)::
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
+from numba import boolean, prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import placements, world_placements
 
 
 @kernel
 def workspace(nb):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
-            np.empty((nb, 6)), np.empty((nb, 6)), np.empty((nb, 6)), np.empty((3, 3)), np.empty(3),
-            np.empty(6), np.empty(6), np.empty(6))
+    """Scratch of :func:`rnea_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2)``."""
+    buf = np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18)
+    P, o = poses(buf, 0, nb)
+    vel, o = take(buf, o, (nb, 6))
+    acc, o = take(buf, o, (nb, 6))
+    f, o = take(buf, o, (nb, 6))
+    vJ, o = take(buf, o, (6,))
+    t1, o = take(buf, o, (6,))
+    t2, o = take(buf, o, (6,))
+    return buf, P, vel, acc, f, vJ, t1, t2
 
 
 @kernel
@@ -77,7 +85,7 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
 
     ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
     """
-    liR, lip, oR, op, vel, acc, f, Rj, pj, vJ, t1, t2 = ws
+    _, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2 = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and a.shape[0] == nv):
         return WRONG_SIZE
@@ -130,7 +138,7 @@ def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
     return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
 
 
-@kernel
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
 def _rnea_packed(ints, packed, q, v, a, check, tau):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
@@ -178,11 +186,14 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     nonlinear_effects(q, v)``, ``rnea(q, v, a) == crba(q) a + nonlinear_effects(q, v)`` without
     friction. Reference: Featherstone, RBDA (2008), Table 5.1.
     """
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a):
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
         k = model._kernel  # fast path for one state: the kernel checks sizes and values
         tau = np.empty(model.nv)
-        if _rnea_packed(k["ints"], k["packed"][bool(friction), bool(armature)], q, v, a, check_finite, tau) == OK:
-            return tau
+        try:
+            if _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite, tau) == OK:
+                return tau
+        except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
+            pass
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)
