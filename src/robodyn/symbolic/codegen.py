@@ -1,13 +1,14 @@
 """Code generation from closed-form expressions: NumPy, Numba and C.
 
 A :class:`Program` is a list of expressions (an output array, row-major) in the joint
-symbols, with ``sin q_k``, ``cos q_k`` as the plain symbols ``s_k``, ``c_k``, reduced by
-common-subexpression elimination (``sympy.cse``, or for big programs a table of the
-distinct monomials, :func:`monomial_cse`) to a sequence of scalar assignments.
-The same program prints as
+symbols, with ``sin q_k``, ``cos q_k`` as the plain symbols ``s_k``, ``c_k``, after a
+sequence of scalar assignments: either the expanded terms reduced by common-subexpression
+elimination (:func:`program`: ``sympy.cse``, or for big programs a table of the distinct
+monomials, :func:`monomial_cse`), or the recorded steps of a recursion
+(:func:`straight_line`). The same program prints as
 
 * a NumPy function vectorised over leading batch dimensions (:func:`numpy_function`),
-* a Numba-compiled function with a loop over the batch (:func:`numba_function`),
+* a Numba-compiled function for one state, and a loop over a batch (:func:`numba_function`),
 * a C function ``void NAME(const double *q, ..., double *out)`` (:func:`c_function`).
 """
 
