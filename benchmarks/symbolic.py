@@ -85,7 +85,8 @@ def write(text: str) -> None:
         path.write_text(old.rstrip("\n") + "\n" + text)
         return
     end = old.find("\n## ", start + 1)
-    path.write_text(old[:start] + text.lstrip("\n") + (old[end + 1:] if end >= 0 else ""))
+    rest = "\n" + old[end + 1:] if end >= 0 else ""
+    path.write_text(old[:start] + text.strip("\n") + "\n" + rest)
 
 
 def main():

@@ -32,8 +32,8 @@ def _floats(e: sp.Expr) -> sp.Expr:
 @dataclass
 class Program:
     """``outputs`` (flat, row-major, of ``shape``) after ``assignments``; ``args``: the
-    inputs as ``(name, symbols)``; ``trig``: ``(s_k, c_k, q_k)`` for each revolute joint
-    whose sine or cosine appears."""
+    inputs as ``(name, symbols)``; ``trig``: ``(s_k, "sin", q_k)`` and ``(c_k, "cos", q_k)``
+    for each sine and cosine of a joint coordinate that the program uses."""
 
     name: str
     shape: tuple
@@ -152,8 +152,7 @@ def program(name: str, exprs, shape: tuple, args: list, trig: list, doc: str = "
     if polys is not None and sum(len(p) for p in polys) > CSE_TERMS:
         assignments, outputs, used = monomial_cse(polys, values)
         used = set().union(*(v.free_symbols for v in used))
-        trig = [(s, c, q) for s, c, q in trig if s in used or c in used]
-        return Program(name, tuple(shape), args, trig, assignments, outputs, doc)
+        return Program(name, tuple(shape), args, _used_trig(trig, used), assignments, outputs, doc)
     exprs = [sp.sympify(e) for e in exprs]
     if exprs and any(not e.is_number for e in exprs):
         assignments, outputs = sp.cse(exprs, symbols=sp.numbered_symbols("x", real=True), order="none")
@@ -176,15 +175,21 @@ def straight_line(name: str, assignments, outputs, shape: tuple, args: list, tri
     return _finish(name, shape, args, trig, kept[::-1], outputs, doc)
 
 
+def _used_trig(trig, used) -> list:
+    """``(symbol, "sin" or "cos", q_k)`` of the sines and cosines in ``used``, from the
+    ``(s_k, c_k, q_k)`` of the revolute joints."""
+    return [(x, fn, q) for s, c, q in trig for x, fn in ((s, "sin"), (c, "cos")) if x in used]
+
+
 def _finish(name, shape, args, trig, assignments, outputs, doc) -> Program:
     """Floats for rationals, long sums split, the trigonometric inputs that are used; raises
     ``ValueError`` for symbols that are neither inputs nor assigned."""
     used = set().union(set(), *(e.free_symbols for e in outputs), *(e.free_symbols for _, e in assignments))
-    trig = [(s, c, q) for s, c, q in trig if s in used or c in used]
+    trig = _used_trig(trig, used)
     assignments = [(s, _floats(e)) for s, e in assignments]
     outputs = [_floats(e) for e in outputs]
     assignments, outputs = _split_sums(assignments, outputs)
-    known = {s for _, syms in args for s in syms} | {s for s, _, _ in trig} | {c for _, c, _ in trig}
+    known = {s for _, syms in args for s in syms} | {s for s, _, _ in trig}
     known |= {s for s, _ in assignments}
     missing = set().union(*(e.free_symbols for e in outputs), *(e.free_symbols for _, e in assignments)) - known
     if missing:
@@ -205,8 +210,8 @@ def numpy_source(prog: Program) -> str:
     for a, syms in prog.args:
         for k, s in enumerate(syms):
             lines.append(f"    {s} = {a}[..., {k}]")
-    for s, c, q in prog.trig:
-        lines.append(f"    {s} = numpy.sin({q})\n    {c} = numpy.cos({q})")
+    for s, fn, q in prog.trig:
+        lines.append(f"    {s} = numpy.{fn}({q})")
     for s, e in prog.assignments:
         lines.append(f"    {s} = {_fmt(pr.doprint, e)}")
     lines.append(f"    _out = numpy.empty(_batch + {prog.shape!r})")
@@ -253,8 +258,8 @@ def numba_source(prog: Program) -> str:
     for a, syms in prog.args:
         for k, s in enumerate(syms):
             lines.append(f"    {s} = {a}[{k}]")
-    for s, c, q in prog.trig:
-        lines.append(f"    {s} = math.sin({q})\n    {c} = math.cos({q})")
+    for s, fn, q in prog.trig:
+        lines.append(f"    {s} = math.{fn}({q})")
     for s, e in prog.assignments:
         lines.append(f"    {s} = {_fmt(pr.doprint, e)}")
     for k, e in enumerate(prog.outputs):
@@ -335,8 +340,8 @@ def c_function(prog: Program, prefix: str) -> str:
     for a, syms in prog.args:
         for k, s in enumerate(syms):
             lines.append(f"    const double {s} = {a}[{k}];")
-    for s, c, q in prog.trig:
-        lines.append(f"    const double {s} = sin({q});\n    const double {c} = cos({q});")
+    for s, fn, q in prog.trig:
+        lines.append(f"    const double {s} = {fn}({q});")
     for s, e in prog.assignments:
         lines.append(f"    const double {s} = {_fmt(_c, e)};")
     for k, e in enumerate(prog.outputs):
