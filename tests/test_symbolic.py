@@ -213,8 +213,14 @@ def test_recursive_mass_matrix_is_the_expanded_one():
 
 def test_recursive_forms_with_parameters():
     """Models with free symbols: the recursive and the expanded code take the same params."""
+    a1, alpha1, d2, m1 = sp.symbols("a1 alpha1 d2 m1", real=True)
+    twisted = [DHLink(a=a1, alpha=alpha1, d=0, mass=m1, com=(0.1, 0, 0), inertia=sp.diag(0.1, 0.2, 0.3)),
+               DHLink(a=0.3, alpha=0, d=d2, mass=2, com=(0, 0.1, 0.05), inertia=sp.diag(0.1, 0.2, 0.3)),
+               DHLink(a=0, alpha=0, d=0, theta=0.2, joint="prismatic", mass=1, com=(0, 0, 0.1),
+                      inertia=sp.diag(0.1, 0.1, 0.1))]
     models = {"planar_2r": planar_2r_symbolic()[0], "scara": scara_symbolic()[0],
-              "elbow_3r": S.with_inertia_symbols(rd.models.load("elbow_3r"))}
+              "elbow_3r": S.with_inertia_symbols(rd.models.load("elbow_3r")),
+              "twisted": S.from_dh(twisted, convention="modified")}  # cos(alpha1), sin(alpha1) in the code
     for name, model in models.items():
         eom = S.equations_of_motion(model)
         rng = rng_for(name, "forms")
