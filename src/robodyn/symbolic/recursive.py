@@ -8,8 +8,9 @@ run once on symbols (:class:`._emit.Emitter`) and written as straight-line code,
 assignment per intermediate scalar: ``sin q_k`` and ``cos q_k`` once each, then the entries
 of the joint rotations, velocities, composite inertias and forces, with every zero and one of
 the model's numbers folded away. Nothing is expanded, so the code of the Panda's ``M`` has
-about 700 operations where its expanded form (:func:`.equations_of_motion`) has 6,155
-monomials, and it is generated and compiled in about a second. The values are the same
+about 200 assignments (550 arithmetic operations) where its expanded form
+(:func:`.equations_of_motion`) has 6,155 monomials, and it is generated and compiled in one
+to two seconds. The values are the same
 functions of ``q`` (exact arithmetic on the model's numbers until the code is printed).
 Models with free symbols (:func:`.with_inertia_symbols`, symbolic DH tables) give functions
 that take ``params`` as the expanded forms do. Reference: W. Khalil, E. Dombre, *Modeling,
