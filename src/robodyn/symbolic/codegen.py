@@ -197,6 +197,15 @@ def _finish(name, shape, args, trig, assignments, outputs, doc) -> Program:
     return Program(name, tuple(shape), args, trig, assignments, outputs, doc)
 
 
+def _statements(prog: Program, printer, unpack: str, trig: str, assign: str) -> list[str]:
+    """The statements before the outputs, in one language's templates: the inputs unpacked
+    (``unpack`` with ``s, a, k``), the sines and cosines (``trig`` with ``s, fn, q``) and the
+    assignments (``assign`` with ``s, e``, ``e`` written by ``printer``)."""
+    lines = [unpack.format(s=s, a=a, k=k) for a, syms in prog.args for k, s in enumerate(syms)]
+    lines += [trig.format(s=s, fn=fn, q=q) for s, fn, q in prog.trig]
+    return lines + [assign.format(s=s, e=_fmt(printer, e)) for s, e in prog.assignments]
+
+
 # -- NumPy ---------------------------------------------------------------------------------
 def numpy_source(prog: Program) -> str:
     from sympy.printing.numpy import NumPyPrinter
@@ -207,13 +216,7 @@ def numpy_source(prog: Program) -> str:
     for a, syms in prog.args:
         lines.append(f"    {a} = _check({a}, {len(syms)}, {a!r})")
     lines.append(f"    _batch = numpy.broadcast_shapes({', '.join(f'{a}.shape[:-1]' for a in prog.arg_names)})")
-    for a, syms in prog.args:
-        for k, s in enumerate(syms):
-            lines.append(f"    {s} = {a}[..., {k}]")
-    for s, fn, q in prog.trig:
-        lines.append(f"    {s} = numpy.{fn}({q})")
-    for s, e in prog.assignments:
-        lines.append(f"    {s} = {_fmt(pr.doprint, e)}")
+    lines += _statements(prog, pr.doprint, "    {s} = {a}[..., {k}]", "    {s} = numpy.{fn}({q})", "    {s} = {e}")
     lines.append(f"    _out = numpy.empty(_batch + {prog.shape!r})")
     for k, e in enumerate(prog.outputs):
         idx = ", ".join(str(i) for i in np.unravel_index(k, prog.shape)) if prog.shape else ""
@@ -255,13 +258,7 @@ def numba_source(prog: Program) -> str:
     pr = PythonCodePrinter({"fully_qualified_modules": True})
     names = prog.arg_names
     lines = [f"def {prog.name}_one({', '.join(names)}, OUT):"]
-    for a, syms in prog.args:
-        for k, s in enumerate(syms):
-            lines.append(f"    {s} = {a}[{k}]")
-    for s, fn, q in prog.trig:
-        lines.append(f"    {s} = math.{fn}({q})")
-    for s, e in prog.assignments:
-        lines.append(f"    {s} = {_fmt(pr.doprint, e)}")
+    lines += _statements(prog, pr.doprint, "    {s} = {a}[{k}]", "    {s} = math.{fn}({q})", "    {s} = {e}")
     for k, e in enumerate(prog.outputs):
         lines.append(f"    OUT[{_out_index(prog, k)}] = {_fmt(pr.doprint, e)}")
     ins = [f"{a.upper()}_" for a in names]
@@ -337,13 +334,8 @@ def c_function(prog: Program, prefix: str) -> str:
     """C source of ``prog``: inputs ``const double *`` of the joint and parameter vectors,
     ``out`` row-major of ``shape``."""
     lines = [f"/* {prog.doc} */", c_prototype(prog, prefix), "{"]
-    for a, syms in prog.args:
-        for k, s in enumerate(syms):
-            lines.append(f"    const double {s} = {a}[{k}];")
-    for s, fn, q in prog.trig:
-        lines.append(f"    const double {s} = {fn}({q});")
-    for s, e in prog.assignments:
-        lines.append(f"    const double {s} = {_fmt(_c, e)};")
+    lines += _statements(prog, _c, "    const double {s} = {a}[{k}];", "    const double {s} = {fn}({q});",
+                         "    const double {s} = {e};")
     for k, e in enumerate(prog.outputs):
         lines.append(f"    out[{k}] = {_fmt(_c, e)};")
     lines.append("}")
