@@ -136,26 +136,23 @@ class TrigRing(VectorAlgebra):
     def expr(self, p, trig: str = "functions") -> sp.Expr:
         """``p`` as a sympy expression: ``trig="functions"`` writes ``sin(q1)``, ``cos(q1)``;
         ``trig="symbols"`` writes the plain symbols ``s1``, ``c1`` (for generated code)."""
-        e = p.as_expr()
-        if trig == "symbols":
-            sub = {v: k for k, v in self.atom_dummies.items()}
-            for k in range(self.model.nv):
-                if self.revolute[k]:
-                    s, c = self.trig_names(k)
-                    sub[self._pos_dummies[k]] = s
-                    sub[self._cos_dummies[self._cos_number(k)]] = c
-            return e.xreplace(sub)
-        return e.xreplace(self.to_sympy)
+        return p.as_expr().xreplace(self._code_values() if trig == "symbols" else self.to_sympy)
 
-    def generator_values(self) -> list:
-        """The value of each generator in generated code: ``s_k``, ``c_k`` as the plain
-        symbols of :meth:`trig_names`, atoms as themselves, other generators unchanged."""
+    def _code_values(self) -> dict:
+        """Generator dummies -> their values in generated code: ``s_k``, ``c_k`` as the plain
+        symbols of :meth:`trig_names`, atoms as themselves."""
         sub = {v: k for k, v in self.atom_dummies.items()}
         for k in range(self.model.nv):
             if self.revolute[k]:
                 s, c = self.trig_names(k)
                 sub[self._pos_dummies[k]] = s
                 sub[self._cos_dummies[self._cos_number(k)]] = c
+        return sub
+
+    def generator_values(self) -> list:
+        """The value of each generator in generated code (:meth:`_code_values`; other
+        generators unchanged)."""
+        sub = self._code_values()
         return [sub.get(g, g) for g in self.ring.symbols]
 
     # -- arithmetic ----------------------------------------------------------------------
