@@ -242,7 +242,7 @@ def test_recursive_forms_with_parameters():
 
 def test_recursive_prismatic_joints_on_random_trees():
     for seed in range(3):
-        model = rd.random.random_model(5, seed=seed, floating_base=False, branching=0.6)
+        model = rd.random.random_model(4, seed=seed, floating_base=False, branching=0.6)
         rec = S.recursive_dynamics(model)
         q, v, a = random_states(model, 4, seed, "recursive")
         expected = numeric_terms(model, q, v, a)
