@@ -49,12 +49,10 @@ def signature(model, name: str, how: str) -> tuple[list, str]:
 
 class GeneratedCode:
     """NumPy, Numba and C functions of the terms, from ``self.program(name, form)``
-    (a :class:`~.codegen.Program`); ``self.model`` is the :class:`~.model.SymbolicModel`."""
+    (a :class:`~.codegen.Program`, defined by the subclass); ``self.model`` is the
+    :class:`~.model.SymbolicModel`."""
 
     default_c_terms: tuple = ()
-
-    def program(self, name: str, form: str = "auto") -> codegen.Program:
-        raise NotImplementedError
 
     def to_function(self, name: str, form: str = "auto"):
         """NumPy function of a term, vectorised over leading batch dimensions:
