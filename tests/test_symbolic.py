@@ -110,6 +110,160 @@ def test_c_code_compiles_and_matches(derived, name, tmp_path):
         assert_rel(call_c(lib[f"{name}_tau"], n, q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
 
 
+# -- generated code of the recursions -------------------------------------------------------
+ALL_ROBOTS = SMALL_ROBOTS + ["panda"]
+RECURSIVE_TERMS = ("M", "C_qd", "g", "tau")
+
+
+@pytest.fixture(scope="module")
+def recursive():
+    """Each built-in robot's recursions (armature on every joint, so that it is tested too)."""
+    out = {}
+    for name in ALL_ROBOTS:
+        model = rd.models.load(name)
+        model = model.replace(armature=rng_for(name, "armature").uniform(0.01, 0.1, model.nv))
+        out[name] = (model, S.recursive_dynamics(model))
+    return out
+
+
+def numeric_terms(model, q, v, a):
+    """The recursive terms by the numeric kernels: M, C qd, g, tau."""
+    g = rd.gravity(model, q)
+    return {"M": rd.crba(model, q), "C_qd": rd.rnea(model, q, v, 0 * v, friction=False) - g, "g": g,
+            "tau": rd.rnea(model, q, v, a, friction=False)}
+
+
+def inputs(term, q, v, a):
+    return {"M": (q,), "C_qd": (q, v), "g": (q,), "tau": (q, v, a)}[term]
+
+
+@pytest.mark.parametrize("name", ALL_ROBOTS)
+def test_recursive_terms_match_numeric_kernels(recursive, name):
+    model, rec = recursive[name]
+    q, v, a = random_states(model, 8, "recursive")
+    expected = numeric_terms(model, q, v, a)
+    for term in RECURSIVE_TERMS:
+        f = rec.to_function(term)
+        assert_rel(f(*inputs(term, q, v, a)), expected[term], 1e-12, term)
+        assert_rel(f(*inputs(term, q[0], v[0], a[0])), expected[term][0], 1e-12, f"{term}, one state")
+    # straight-line code: for 6 and 7 joints far fewer assignments than monomials in M
+    assert len(rec.program("M").assignments) < 25 * model.nv**2
+
+
+@pytest.mark.parametrize("name", ["puma560", "panda"])
+def test_recursive_numba_mass_matrix(recursive, name):
+    model, rec = recursive[name]
+    q, _, _ = random_states(model, 6, "recursive numba")
+    M = rec.to_numba("M")
+    expected = rd.crba(model, q)
+    for k in range(len(q)):  # the single-state path: 1-D float64 arrays
+        assert_rel(M(q[k]), expected[k], 1e-12, "M, one state")
+    assert_rel(M(q.reshape(2, 3, -1)), expected.reshape(2, 3, model.nv, model.nv), 1e-12, "M, 2-d batch")
+
+
+def test_recursive_numba_inputs(recursive):
+    model, rec = recursive["scara"]
+    q, v, a = random_states(model, 6, "recursive numba")
+    expected = numeric_terms(model, q, v, a)
+    M = rec.to_numba("M")
+    assert_rel(M(q), expected["M"], 1e-12, "M")
+    assert_rel(M(list(q[0])), expected["M"][0], 1e-12, "M, a list")
+    assert_rel(M(np.asfortranarray(q).T[:, 1]), expected["M"][1], 1e-12, "M, a strided vector")
+    assert_rel(M(q[2].astype(np.float32)), rd.crba(model, q[2].astype(np.float32).astype(float)), 1e-12,
+               "M, float32")
+    with pytest.raises(ValueError, match=r"q: expected shape \(\.\.\., 4\), got \(5,\)"):
+        M(np.zeros(5))
+    with pytest.raises(ValueError, match=r"q: expected shape \(\.\.\., 4\), got \(\)"):
+        M(1.0)
+    tau = rec.to_numba("tau")
+    assert_rel(tau(q, v, a), expected["tau"], 1e-12, "tau")
+    q0, v0 = np.broadcast_to(q[0], q.shape), np.broadcast_to(v[0], v.shape)
+    assert_rel(tau(q[0], v[0], a), rd.rnea(model, q0, v0, a, friction=False), 1e-12, "tau, broadcast")
+    with pytest.raises(ValueError, match=r"qdd: expected shape \(\.\.\., 4\), got \(3,\)"):
+        tau(q[0], v[0], a[0, :3])
+    assert_rel(rec.to_numba("C_qd")(q[2], v[2]), expected["C_qd"][2], 1e-12, "C_qd, one state")
+
+
+@pytest.mark.parametrize("name", ["puma560", "panda"])
+def test_recursive_c_code(recursive, name, tmp_path):
+    model, rec = recursive[name]
+    files = rec.to_c(tmp_path)
+    header = (tmp_path / f"{name}_dynamics.h").read_text()
+    assert "composite-rigid-body recursion" in header
+    lib = compile_c(files, tmp_path, name)
+    n = model.nv
+    q, v, a = random_states(model, 4, "recursive c")
+    expected = numeric_terms(model, q, v, a)
+    for k in range(len(q)):
+        for term in RECURSIVE_TERMS:
+            out = call_c(lib[f"{name}_{term}"], expected[term][k].size, *inputs(term, q[k], v[k], a[k]))
+            assert_rel(out.reshape(expected[term][k].shape), expected[term][k], 1e-12, term)
+    assert n == int(header.split(f"#define {name.upper()}_NV ")[1].split()[0])
+
+
+def test_recursive_mass_matrix_is_the_expanded_one():
+    """The composite-rigid-body recursion on exact polynomials gives exactly the Lagrange M."""
+    from robodyn.symbolic import crba, lagrange
+    from robodyn.symbolic._ring import TrigRing
+
+    for name in ("scara", "puma560"):
+        rg = TrigRing(S.from_model(rd.models.load(name)))
+        assert crba.mass_matrix(rg) == lagrange.mass_matrix(rg), name
+
+
+def test_recursive_forms_with_parameters():
+    """Models with free symbols: the recursive and the expanded code take the same params."""
+    a1, alpha1, d2, m1 = sp.symbols("a1 alpha1 d2 m1", real=True)
+    twisted = [DHLink(a=a1, alpha=alpha1, d=0, mass=m1, com=(0.1, 0, 0), inertia=sp.diag(0.1, 0.2, 0.3)),
+               DHLink(a=0.3, alpha=0, d=d2, mass=2, com=(0, 0.1, 0.05), inertia=sp.diag(0.1, 0.2, 0.3)),
+               DHLink(a=0, alpha=0, d=0, theta=0.2, joint="prismatic", mass=1, com=(0, 0, 0.1),
+                      inertia=sp.diag(0.1, 0.1, 0.1))]
+    models = {"planar_2r": planar_2r_symbolic()[0], "scara": scara_symbolic()[0],
+              "elbow_3r": S.with_inertia_symbols(rd.models.load("elbow_3r")),
+              "twisted": S.from_dh(twisted, convention="modified")}  # cos(alpha1), sin(alpha1) in the code
+    for name, model in models.items():
+        eom = S.equations_of_motion(model)
+        rng = rng_for(name, "forms")
+        params = rng.uniform(0.5, 2.0, len(eom.parameters))
+        q, v, a = rng.uniform(-3, 3, (3, 5, model.nv))
+        for term in RECURSIVE_TERMS:
+            fast, full = eom.to_function(term), eom.to_function(term, form="expanded")
+            assert "recursion" in eom.program(term).doc and "expanded" in eom.program(term, "expanded").doc
+            assert_rel(fast(*inputs(term, q, v, a), params), full(*inputs(term, q, v, a), params), 1e-12, term)
+    # the numbers of a numeric model as parameters: the numeric kernels
+    numeric = rd.models.load("elbow_3r")
+    rec = S.recursive_dynamics(models["elbow_3r"])
+    values = dict(zip([s.name for s in models["elbow_3r"].inertial_parameters()], numeric.inertial_parameters()))
+    params = np.array([values[s.name] for s in rec.parameters])
+    q, v, a = random_states(numeric, 5, "forms")
+    assert_rel(rec.to_numba("M")(q, params), rd.crba(numeric, q), 1e-12, "M with parameters")
+    assert_rel(rec.to_function("tau")(q, v, a, params), rd.rnea(numeric, q, v, a), 1e-12, "tau with parameters")
+
+
+def test_recursive_prismatic_joints_on_random_trees():
+    for seed in range(3):
+        model = rd.random.random_model(4, seed=seed, floating_base=False, branching=0.6)
+        rec = S.recursive_dynamics(model)
+        q, v, a = random_states(model, 4, seed, "recursive")
+        expected = numeric_terms(model, q, v, a)
+        for term in RECURSIVE_TERMS:
+            assert_rel(rec.to_function(term)(*inputs(term, q, v, a)), expected[term], 1e-12, term)
+
+
+def test_form_errors(derived):
+    model, eom, _ = derived["planar_2r"]
+    with pytest.raises(ValueError, match="form must be one of"):
+        eom.to_function("M", form="fast")
+    with pytest.raises(ValueError, match="form='recursive' is available for"):
+        eom.program("C", form="recursive")
+    assert eom.program("C").doc.endswith("expanded (lagrange derivation)")
+    rec = S.recursive_dynamics(model)
+    with pytest.raises(ValueError, match="needs the derived equations"):
+        rec.program("M", form="expanded")
+    with pytest.raises(ValueError, match="term must be one of"):
+        rec.program("C")
+
+
 # -- the two routes -------------------------------------------------------------------------
 def spherical_pendulum():
     """Point mass m on a massless rod of length l; q1 = azimuth phi about the vertical z,

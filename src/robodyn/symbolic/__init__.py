@@ -4,21 +4,24 @@
     eom = rd.symbolic.equations_of_motion(rd.models.load("planar_2r"))
     eom.M, eom.C, eom.g, eom.T, eom.U, eom.L, eom.tau     # sympy, in q, qd, qdd
     M = eom.to_function("M")                              # NumPy, batched: M(q) (..., n, n)
+    M = rd.symbolic.recursive_dynamics(model).to_numba("M")   # fast M without deriving
     eom.to_c("out/")                                      # C source and header
     print(eom.latex())                                    # LaTeX document
 
 Symbolic models (:class:`SymbolicModel`) come from a numeric model (:func:`from_model`), a
 DH table with symbols (:func:`from_dh`), or either with named inertial parameters
-(:func:`with_inertia_symbols`); :func:`regressor` gives ``Y(q, qd, qdd)`` with
-``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
+(:func:`with_inertia_symbols`); :func:`recursive_dynamics` generates ``M``, ``C qd``, ``g``
+and ``tau`` from the recursions without the expanded derivation; :func:`regressor` gives
+``Y(q, qd, qdd)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
 """
 
 from .equations import EquationsOfMotion, equations_of_motion
 from .model import (SymbolicModel, from_dh, from_model, inertia_symbols, inertial_parameters,
                     with_inertia_symbols)
+from .recursive import RecursiveDynamics, recursive_dynamics
 from .regressor import Regressor, regressor
 
 __all__ = [
-    "EquationsOfMotion", "Regressor", "SymbolicModel", "equations_of_motion", "from_dh", "from_model",
-    "inertia_symbols", "inertial_parameters", "regressor", "with_inertia_symbols",
+    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "from_dh",
+    "from_model", "inertia_symbols", "inertial_parameters", "recursive_dynamics", "regressor", "with_inertia_symbols",
 ]

@@ -42,7 +42,35 @@ def _nonpolynomial_atoms(e: sp.Expr) -> set:
     return out
 
 
-class TrigRing:
+def trig_names(k: int) -> tuple[sp.Symbol, sp.Symbol]:
+    """Plain symbols ``s{k+1}``, ``c{k+1}`` (``sin q_{k+1}``, ``cos q_{k+1}``) for generated code."""
+    return sp.Symbol(f"s{k + 1}", real=True), sp.Symbol(f"c{k + 1}", real=True)
+
+
+class VectorAlgebra:
+    """3-vector and 3 x 3 matrix products on scalars of a derivation, each entry passed
+    through ``self.reduce`` (trigonometric reduction in :class:`TrigRing`, a named
+    intermediate in :class:`~._emit.Emitter`)."""
+
+    def matvec(self, R, v):
+        return [self.reduce(R[r][0] * v[0] + R[r][1] * v[1] + R[r][2] * v[2]) for r in range(3)]
+
+    def matTvec(self, R, v):
+        return [self.reduce(R[0][r] * v[0] + R[1][r] * v[1] + R[2][r] * v[2]) for r in range(3)]
+
+    def matmul(self, A, B):
+        return [[self.reduce(sum((A[r][k] * B[k][c] for k in range(3)), self.zero)) for c in range(3)]
+                for r in range(3)]
+
+    @staticmethod
+    def cross(a, b):
+        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+    def dot(self, a, b):
+        return self.reduce(sum((x * y for x, y in zip(a, b)), self.zero))
+
+
+class TrigRing(VectorAlgebra):
     """The polynomial ring of a model's derivation, with trigonometric reduction,
     differentiation along ``q`` and conversion to and from sympy expressions."""
 
@@ -101,33 +129,30 @@ class TrigRing:
     def mat(self, m) -> list:
         return [[self.const(m[r, c]) for c in range(3)] for r in range(3)]
 
-    def trig_names(self, k: int) -> tuple[sp.Symbol, sp.Symbol]:
-        """Plain symbols ``s{k+1}``, ``c{k+1}`` for generated code."""
-        return sp.Symbol(f"s{k + 1}", real=True), sp.Symbol(f"c{k + 1}", real=True)
+    @staticmethod
+    def trig_names(k: int) -> tuple[sp.Symbol, sp.Symbol]:
+        return trig_names(k)
 
     def expr(self, p, trig: str = "functions") -> sp.Expr:
         """``p`` as a sympy expression: ``trig="functions"`` writes ``sin(q1)``, ``cos(q1)``;
         ``trig="symbols"`` writes the plain symbols ``s1``, ``c1`` (for generated code)."""
-        e = p.as_expr()
-        if trig == "symbols":
-            sub = {v: k for k, v in self.atom_dummies.items()}
-            for k in range(self.model.nv):
-                if self.revolute[k]:
-                    s, c = self.trig_names(k)
-                    sub[self._pos_dummies[k]] = s
-                    sub[self._cos_dummies[self._cos_number(k)]] = c
-            return e.xreplace(sub)
-        return e.xreplace(self.to_sympy)
+        return p.as_expr().xreplace(self._code_values() if trig == "symbols" else self.to_sympy)
 
-    def generator_values(self) -> list:
-        """The value of each generator in generated code: ``s_k``, ``c_k`` as the plain
-        symbols of :meth:`trig_names`, atoms as themselves, other generators unchanged."""
+    def _code_values(self) -> dict:
+        """Generator dummies -> their values in generated code: ``s_k``, ``c_k`` as the plain
+        symbols of :meth:`trig_names`, atoms as themselves."""
         sub = {v: k for k, v in self.atom_dummies.items()}
         for k in range(self.model.nv):
             if self.revolute[k]:
                 s, c = self.trig_names(k)
                 sub[self._pos_dummies[k]] = s
                 sub[self._cos_dummies[self._cos_number(k)]] = c
+        return sub
+
+    def generator_values(self) -> list:
+        """The value of each generator in generated code (:meth:`_code_values`; other
+        generators unchanged)."""
+        sub = self._code_values()
         return [sub.get(g, g) for g in self.ring.symbols]
 
     # -- arithmetic ----------------------------------------------------------------------
@@ -189,21 +214,3 @@ class TrigRing:
     def coefficient(self, p, j: int, which: str = "qdd"):
         """The coefficient of ``qdd_j`` (or ``qd_j``) in ``p``, which is linear in it."""
         return p.diff(self.qdd[j] if which == "qdd" else self.qd[j])
-
-    # -- vectors -------------------------------------------------------------------------
-    def matvec(self, R, v):
-        return [self.reduce(R[r][0] * v[0] + R[r][1] * v[1] + R[r][2] * v[2]) for r in range(3)]
-
-    def matTvec(self, R, v):
-        return [self.reduce(R[0][r] * v[0] + R[1][r] * v[1] + R[2][r] * v[2]) for r in range(3)]
-
-    def matmul(self, A, B):
-        return [[self.reduce(sum((A[r][k] * B[k][c] for k in range(3)), self.zero)) for c in range(3)]
-                for r in range(3)]
-
-    @staticmethod
-    def cross(a, b):
-        return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
-
-    def dot(self, a, b):
-        return self.reduce(sum((x * y for x, y in zip(a, b)), self.zero))

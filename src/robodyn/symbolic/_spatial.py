@@ -75,6 +75,23 @@ def inertia_mul(rg: TrigRing, theta, V) -> list:
     return f + n
 
 
+def inertia_act(rg: TrigRing, R, p, theta) -> list:
+    """Inertial parameters of a body in the parent frame of its placement ``(R, p)``:
+    ``[m, R h + m p, R I_o R^T - p y^T - y p^T + (2 p . y + m p . p) 1 - m p p^T]``
+    with ``y = R h`` (parallel-axis theorem about the parent origin, as
+    :func:`robodyn.spatial.inertia_act`)."""
+    m, h = theta[0], theta[1:4]
+    Io = [[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]]
+    y = rg.matvec(R, h)
+    A = rg.matmul(R, Io)
+    py = 2 * rg.dot(p, y) + m * rg.dot(p, p)
+    out = [m] + [rg.reduce(y[r] + m * p[r]) for r in range(3)]
+    for r, c in ((0, 0), (0, 1), (1, 1), (0, 2), (1, 2), (2, 2)):  # Ixx, Ixy, Iyy, Ixz, Iyz, Izz
+        RIR = sum((A[r][k] * R[c][k] for k in range(3)), rg.zero)
+        out.append(rg.reduce(RIR - p[r] * y[c] - y[r] * p[c] - m * p[r] * p[c] + (py if r == c else rg.zero)))
+    return out
+
+
 def world_poses(rg: TrigRing) -> list:
     """``(oR_i, op_i)`` of every body in the world frame."""
     out = []

@@ -10,7 +10,9 @@ from .equations import equations_of_motion
 
 def run_derive(model, args) -> int:
     """Derive the closed-form terms of ``model``, print a summary (the terms themselves for
-    up to 3 joints), and write the LaTeX document and the C code when asked."""
+    up to 3 joints), and write the LaTeX document and the C code when asked (``M``, ``g``,
+    ``tau`` as the straight-line code of the recursions, ``C`` expanded: see
+    :meth:`.EquationsOfMotion.program`)."""
     t0 = time.perf_counter()
     eom = equations_of_motion(model, method=args.method)
     t1 = time.perf_counter()
@@ -28,6 +30,6 @@ def run_derive(model, args) -> int:
         print(f"  LaTeX: {args.latex}")
     if args.c_dir:
         files = eom.to_c(args.c_dir)
-        print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)}")
+        print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)} (M, g, tau by the recursions, C expanded)")
     sys.stdout.flush()
     return 0

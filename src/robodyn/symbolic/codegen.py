@@ -1,13 +1,14 @@
 """Code generation from closed-form expressions: NumPy, Numba and C.
 
 A :class:`Program` is a list of expressions (an output array, row-major) in the joint
-symbols, with ``sin q_k``, ``cos q_k`` as the plain symbols ``s_k``, ``c_k``, reduced by
-common-subexpression elimination (``sympy.cse``, or for big programs a table of the
-distinct monomials, :func:`monomial_cse`) to a sequence of scalar assignments.
-The same program prints as
+symbols, with ``sin q_k``, ``cos q_k`` as the plain symbols ``s_k``, ``c_k``, after a
+sequence of scalar assignments: either the expanded terms reduced by common-subexpression
+elimination (:func:`program`: ``sympy.cse``, or for big programs a table of the distinct
+monomials, :func:`monomial_cse`), or the recorded steps of a recursion
+(:func:`straight_line`). The same program prints as
 
 * a NumPy function vectorised over leading batch dimensions (:func:`numpy_function`),
-* a Numba-compiled function with a loop over the batch (:func:`numba_function`),
+* a Numba-compiled function for one state, and a loop over a batch (:func:`numba_function`),
 * a C function ``void NAME(const double *q, ..., double *out)`` (:func:`c_function`).
 """
 
@@ -31,8 +32,8 @@ def _floats(e: sp.Expr) -> sp.Expr:
 @dataclass
 class Program:
     """``outputs`` (flat, row-major, of ``shape``) after ``assignments``; ``args``: the
-    inputs as ``(name, symbols)``; ``trig``: ``(s_k, c_k, q_k)`` for each revolute joint
-    whose sine or cosine appears."""
+    inputs as ``(name, symbols)``; ``trig``: ``(s_k, "sin", q_k)`` and ``(c_k, "cos", q_k)``
+    for each sine and cosine of a joint coordinate that the program uses."""
 
     name: str
     shape: tuple
@@ -151,24 +152,58 @@ def program(name: str, exprs, shape: tuple, args: list, trig: list, doc: str = "
     if polys is not None and sum(len(p) for p in polys) > CSE_TERMS:
         assignments, outputs, used = monomial_cse(polys, values)
         used = set().union(*(v.free_symbols for v in used))
-        trig = [(s, c, q) for s, c, q in trig if s in used or c in used]
-        return Program(name, tuple(shape), args, trig, assignments, outputs, doc)
+        return Program(name, tuple(shape), args, _used_trig(trig, used), assignments, outputs, doc)
     exprs = [sp.sympify(e) for e in exprs]
     if exprs and any(not e.is_number for e in exprs):
         assignments, outputs = sp.cse(exprs, symbols=sp.numbered_symbols("x", real=True), order="none")
     else:
         assignments, outputs = [], exprs
-    used = set().union(*(e.free_symbols for e in exprs), *(e.free_symbols for _, e in assignments))
-    trig = [(s, c, q) for s, c, q in trig if s in used or c in used]
+    return _finish(name, shape, args, trig, assignments, outputs, doc)
+
+
+def straight_line(name: str, assignments, outputs, shape: tuple, args: list, trig: list, doc: str = "") -> Program:
+    """A :class:`Program` from assignments ``(symbol, expression)`` in evaluation order (the
+    recorded steps of a recursion, :class:`._emit.Emitter`) and ``outputs`` in their
+    symbols; assignments that no output needs are dropped."""
+    outputs = [sp.sympify(e) for e in outputs]
+    need = set().union(set(), *(e.free_symbols for e in outputs))
+    kept = []
+    for s, e in reversed(assignments):
+        if s in need:
+            kept.append((s, e))
+            need |= e.free_symbols
+    return _finish(name, shape, args, trig, kept[::-1], outputs, doc)
+
+
+def _used_trig(trig, used) -> list:
+    """``(symbol, "sin" or "cos", q_k)`` of the sines and cosines in ``used``, from the
+    ``(s_k, c_k, q_k)`` of the revolute joints."""
+    return [(x, fn, q) for s, c, q in trig for x, fn in ((s, "sin"), (c, "cos")) if x in used]
+
+
+def _finish(name, shape, args, trig, assignments, outputs, doc) -> Program:
+    """Floats for rationals, long sums split, the trigonometric inputs that are used; raises
+    ``ValueError`` for symbols that are neither inputs nor assigned."""
+    used = set().union(set(), *(e.free_symbols for e in outputs), *(e.free_symbols for _, e in assignments))
+    trig = _used_trig(trig, used)
     assignments = [(s, _floats(e)) for s, e in assignments]
     outputs = [_floats(e) for e in outputs]
     assignments, outputs = _split_sums(assignments, outputs)
-    known = {s for _, syms in args for s in syms} | {s for s, _, _ in trig} | {c for _, c, _ in trig}
+    known = {s for _, syms in args for s in syms} | {s for s, _, _ in trig}
     known |= {s for s, _ in assignments}
     missing = set().union(*(e.free_symbols for e in outputs), *(e.free_symbols for _, e in assignments)) - known
     if missing:
         raise ValueError(f"{name}: expressions use symbols that are not inputs: {sorted(map(str, missing))}")
     return Program(name, tuple(shape), args, trig, assignments, outputs, doc)
+
+
+def _statements(prog: Program, printer, unpack: str, trig: str, assign: str) -> list[str]:
+    """The statements before the outputs, in one language's templates: the inputs unpacked
+    (``unpack`` with ``s, a, k``), the sines and cosines (``trig`` with ``s, fn, q``) and the
+    assignments (``assign`` with ``s, e``, ``e`` written by ``printer``)."""
+    lines = [unpack.format(s=s, a=a, k=k) for a, syms in prog.args for k, s in enumerate(syms)]
+    lines += [trig.format(s=s, fn=fn, q=q) for s, fn, q in prog.trig]
+    return lines + [assign.format(s=s, e=_fmt(printer, e)) for s, e in prog.assignments]
 
 
 # -- NumPy ---------------------------------------------------------------------------------
@@ -181,13 +216,7 @@ def numpy_source(prog: Program) -> str:
     for a, syms in prog.args:
         lines.append(f"    {a} = _check({a}, {len(syms)}, {a!r})")
     lines.append(f"    _batch = numpy.broadcast_shapes({', '.join(f'{a}.shape[:-1]' for a in prog.arg_names)})")
-    for a, syms in prog.args:
-        for k, s in enumerate(syms):
-            lines.append(f"    {s} = {a}[..., {k}]")
-    for s, c, q in prog.trig:
-        lines.append(f"    {s} = numpy.sin({q})\n    {c} = numpy.cos({q})")
-    for s, e in prog.assignments:
-        lines.append(f"    {s} = {_fmt(pr.doprint, e)}")
+    lines += _statements(prog, pr.doprint, "    {s} = {a}[..., {k}]", "    {s} = numpy.{fn}({q})", "    {s} = {e}")
     lines.append(f"    _out = numpy.empty(_batch + {prog.shape!r})")
     for k, e in enumerate(prog.outputs):
         idx = ", ".join(str(i) for i in np.unravel_index(k, prog.shape)) if prog.shape else ""
@@ -216,28 +245,34 @@ def numpy_function(prog: Program):
 
 
 # -- Numba ---------------------------------------------------------------------------------
+def _out_index(prog: Program, k: int) -> str:
+    """``OUT`` index of output ``k`` in the single-state kernel (scalars: a 1-entry array)."""
+    return ", ".join(str(int(i)) for i in np.unravel_index(k, prog.shape)) if prog.shape else "0"
+
+
 def numba_source(prog: Program) -> str:
+    """``NAME_one(inputs..., OUT)``: one state, ``OUT`` of ``shape`` (``(1,)`` for a scalar);
+    ``NAME_kernel(INPUTS..., OUT)``: a batch, inputs ``(B or 1, n)``, ``OUT (B,) + shape``."""
     from sympy.printing.pycode import PythonCodePrinter
 
     pr = PythonCodePrinter({"fully_qualified_modules": True})
-    ins = [f"{a.upper()}_" for a in prog.arg_names]
-    lines = [f"def {prog.name}_kernel({', '.join(ins)}, OUT):", "    for _b in range(OUT.shape[0]):"]
-    for (a, syms), A in zip(prog.args, ins):
-        lines.append(f"        {a} = {A}[_b if {A}.shape[0] > 1 else 0]")
-        for k, s in enumerate(syms):
-            lines.append(f"        {s} = {a}[{k}]")
-    for s, c, q in prog.trig:
-        lines.append(f"        {s} = math.sin({q})\n        {c} = math.cos({q})")
-    for s, e in prog.assignments:
-        lines.append(f"        {s} = {_fmt(pr.doprint, e)}")
+    names = prog.arg_names
+    lines = [f"def {prog.name}_one({', '.join(names)}, OUT):"]
+    lines += _statements(prog, pr.doprint, "    {s} = {a}[{k}]", "    {s} = math.{fn}({q})", "    {s} = {e}")
     for k, e in enumerate(prog.outputs):
-        lines.append(f"        OUT[_b, {k}] = {_fmt(pr.doprint, e)}")
+        lines.append(f"    OUT[{_out_index(prog, k)}] = {_fmt(pr.doprint, e)}")
+    ins = [f"{a.upper()}_" for a in names]
+    rows = ", ".join(f"{A}[_b if {A}.shape[0] > 1 else 0]" for A in ins)
+    lines += ["", "", f"def {prog.name}_kernel({', '.join(ins)}, OUT):",
+              "    for _b in range(OUT.shape[0]):", f"        {prog.name}_one({rows}, OUT[_b])"]
     return "\n".join(lines) + "\n"
 
 
 def numba_function(prog: Program):
     """The Numba-compiled function of ``prog`` (compiled on first call): same signature and
-    shapes as :func:`numpy_function`, a compiled loop over the batch."""
+    shapes as :func:`numpy_function`. One state (1-D float64 arrays of the right sizes) costs
+    one compiled call that writes into a new array; other inputs go through the checks of
+    :func:`numpy_function` and a compiled loop over the batch."""
     import math
 
     import numba
@@ -247,10 +282,11 @@ def numba_function(prog: Program):
     src = numba_source(prog)
     ns = {"math": math}
     exec(compile(src, f"<robodyn.symbolic {prog.name} numba>", "exec"), ns)
-    # the core kernels' settings: fused multiply-add and reassociation (the sums of thousands
-    # of terms vectorise), NaN/Inf semantics kept
-    kernel = numba.njit(error_model="numpy", fastmath=FASTMATH, nogil=True)(ns[f"{prog.name}_kernel"])
-    size = int(np.prod(prog.shape))
+    # the core kernels' settings: fused multiply-add and reassociation, NaN/Inf semantics kept
+    jit = numba.njit(error_model="numpy", fastmath=FASTMATH, nogil=True)
+    one = ns[f"{prog.name}_one"] = jit(ns[f"{prog.name}_one"])
+    kernel = jit(ns[f"{prog.name}_kernel"])
+    shape = prog.shape or (1,)
     sizes = [len(s) for _, s in prog.args]
     names = prog.arg_names
 
@@ -258,20 +294,23 @@ def numba_function(prog: Program):
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in xs))
         B = int(np.prod(batch))
         flat = [np.ascontiguousarray(np.broadcast_to(x, batch + (n,)).reshape(-1, n)) for x, n in zip(xs, sizes)]
-        out = np.empty((B, size))
+        out = np.empty((B,) + shape)
         kernel(*flat, out)
         return out.reshape(batch + prog.shape)
 
-    # a wrapper written out for this signature: one state costs one kernel call
+    # a wrapper written out for this signature: one state costs one compiled call
     args = ", ".join(names)
-    body = [f"def {prog.name}({args}):"]
+    fast = " and ".join(f"type({a}) is _ndarray and {a}.dtype is _F8 and {a}.shape == ({n},)"
+                        for a, n in zip(names, sizes))
+    body = [f"def {prog.name}({args}):",
+            f"    if {fast}:",
+            f"        out = _empty({shape!r})",
+            f"        _one({args}, out)",
+            f"        return out{'' if prog.shape else '.reshape(())'}"]
     body += [f"    {a} = _check({a}, {n}, {a!r})" for a, n in zip(names, sizes)]
-    body += [f"    if {' and '.join(f'{a}.ndim == 1' for a in names)}:",
-             f"        out = _empty((1, {size}))",
-             f"        _kernel({', '.join(f'{a}[None]' for a in names)}, out)",
-             f"        return out.reshape({prog.shape!r})",
-             f"    return _batched({args})"]
-    ns = {"_check": _check, "_empty": np.empty, "_kernel": kernel, "_batched": batched}
+    body += [f"    return _batched({args})"]
+    ns = {"_check": _check, "_empty": np.empty, "_ndarray": np.ndarray, "_F8": np.dtype(np.float64),
+          "_one": one, "_batched": batched}
     exec("\n".join(body), ns)
     f = ns[prog.name]
     f.__name__ = prog.name
@@ -295,13 +334,8 @@ def c_function(prog: Program, prefix: str) -> str:
     """C source of ``prog``: inputs ``const double *`` of the joint and parameter vectors,
     ``out`` row-major of ``shape``."""
     lines = [f"/* {prog.doc} */", c_prototype(prog, prefix), "{"]
-    for a, syms in prog.args:
-        for k, s in enumerate(syms):
-            lines.append(f"    const double {s} = {a}[{k}];")
-    for s, c, q in prog.trig:
-        lines.append(f"    const double {s} = sin({q});\n    const double {c} = cos({q});")
-    for s, e in prog.assignments:
-        lines.append(f"    const double {s} = {_fmt(_c, e)};")
+    lines += _statements(prog, _c, "    const double {s} = {a}[{k}];", "    const double {s} = {fn}({q});",
+                         "    const double {s} = {e};")
     for k, e in enumerate(prog.outputs):
         lines.append(f"    out[{k}] = {_fmt(_c, e)};")
     lines.append("}")

@@ -17,38 +17,30 @@ in ``q = (q1, ...)``, ``qd = (qd1, ...)``, ``qdd = (qdd1, ...)``:
 Friction is not part of these terms. Expressions of up to ``TRIG_TERMS`` terms are rewritten
 with the angle-sum rules (sympy's ``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay
 otherwise in the canonical expanded form (no ``simplify`` or ``trigsimp`` on big
-expressions, which is what makes other tools take hours). Code
-generation (:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) applies
-common-subexpression elimination.
+expressions, which is what makes other tools take hours). Code generation
+(:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) writes ``M``, ``C_qd``,
+``g`` and ``tau`` by default as the straight-line code of the recursions (:mod:`.recursive`:
+not expanded, fast to compile and to run) and the other terms, or every term with
+``form="expanded"``, as the expanded expressions after common-subexpression elimination.
 """
 
 from __future__ import annotations
 
 from functools import cached_property
-from pathlib import Path
 
 import sympy as sp
 from sympy.simplify.fu import TR10i
 
 from . import codegen, lagrange, newton_euler
 from ._ring import TrigRing
+from ._terms import GeneratedCode, check_form, check_term, signature
 from .model import SymbolicModel, from_model
+from .recursive import RECURSIONS, recursive_program
 
 METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
 # Expressions with at most this many terms are rewritten with the angle-sum rules.
 TRIG_TERMS = 16
 
-# term -> (inputs, description)
-TERMS = {
-    "M": (("q",), "mass matrix M(q), (n, n)"),
-    "C": (("q", "qd"), "Christoffel matrix C(q, qd), (n, n): C qd Coriolis forces, Mdot - 2C skew-symmetric"),
-    "C_qd": (("q", "qd"), "Coriolis and centrifugal forces C(q, qd) qd, (n,)"),
-    "g": (("q",), "gravity forces g(q) = dU/dq, (n,)"),
-    "tau": (("q", "qd", "qdd"), "joint forces M qdd + C qd + g, (n,)"),
-    "T": (("q", "qd"), "kinetic energy qd^T M qd / 2"),
-    "U": (("q",), "potential energy -sum m_i g . p_ci"),
-    "L": (("q", "qd"), "Lagrangian T - U"),
-}
 
 
 def readable_numbers(e: sp.Expr) -> sp.Expr:
@@ -87,9 +79,11 @@ def christoffel_from_quadratic(rg: TrigRing, quad, n: int) -> list:
     return C
 
 
-class EquationsOfMotion:
+class EquationsOfMotion(GeneratedCode):
     """The closed-form terms of one model (module docstring); ``method`` says how they
     were derived. Terms are computed once, on first access."""
+
+    default_c_terms = ("M", "C", "g", "tau")
 
     def __init__(self, model: SymbolicModel, method: str, rg: TrigRing, result: dict):
         self.model = model
@@ -181,8 +175,7 @@ class EquationsOfMotion:
 
     def term(self, name: str):
         """A term by name: ``"M"``, ``"C"``, ``"C_qd"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""
-        if name not in TERMS:
-            raise ValueError(f"term must be one of {list(TERMS)}, got {name!r}")
+        check_term(name)
         return getattr(self, name)
 
     def equals(self, other: "EquationsOfMotion", name: str) -> bool:
@@ -193,72 +186,36 @@ class EquationsOfMotion:
         return all(self._rg.expr(u, "symbols") - other._rg.expr(v, "symbols") == 0 for u, v in zip(flat(a), flat(b)))
 
     # -- output ------------------------------------------------------------------------
-    def program(self, name: str) -> codegen.Program:
-        """The common-subexpression-eliminated :class:`~.codegen.Program` of a term."""
-        if name not in self._programs:
-            self._programs[name] = self._program(name)
-        return self._programs[name]
+    def program(self, name: str, form: str = "auto") -> codegen.Program:
+        """The :class:`~.codegen.Program` of a term, as generated code evaluates it.
 
-    def _program(self, name: str) -> codegen.Program:
-        if name not in TERMS:
-            raise ValueError(f"term must be one of {list(TERMS)}, got {name!r}")
+        ``form="expanded"``: the expanded term (as :attr:`M`, :attr:`C`, ...) after
+        common-subexpression elimination; ``form="recursive"``: ``M`` by the
+        composite-rigid-body recursion, ``C_qd``, ``g``, ``tau`` by the Newton-Euler recursion
+        (:mod:`.recursive`: straight-line code, not expanded, much faster for 6 and more
+        joints); ``form="auto"`` (default): recursive for these four terms, expanded for
+        ``C``, ``T``, ``U``, ``L``. Both forms compute the same functions."""
+        check_form(form)
+        check_term(name)
+        if form == "auto":
+            form = "recursive" if name in RECURSIONS else "expanded"
+        if form == "recursive" and name not in RECURSIONS:
+            raise ValueError(f"form='recursive' is available for {list(RECURSIONS)}, not {name!r}")
+        if (name, form) not in self._programs:
+            self._programs[name, form] = (recursive_program(self.model, name) if form == "recursive"
+                                          else self._expanded_program(name))
+        return self._programs[name, form]
+
+    def _expanded_program(self, name: str) -> codegen.Program:
         rg, n = self._rg, self.n
         p = self._poly[name]
         flat = [x for row in p for x in row] if name in ("M", "C") else (p if isinstance(p, list) else [p])
         shape = (n, n) if name in ("M", "C") else ((n,) if isinstance(p, list) else ())
         big = sum(len(x) for x in flat) > codegen.CSE_TERMS
         exprs = None if big else [rg.expr(x, "symbols") for x in flat]
-        inputs, doc = TERMS[name]
-        args = [(a, list(getattr(self, a))) for a in inputs]
-        if self.parameters:
-            args.append(("params", list(self.parameters)))
+        args, doc = signature(self.model, name, f"expanded ({self.method.replace('_', '-')} derivation)")
         trig = [(*rg.trig_names(k), self.q[k]) for k in range(n) if rg.revolute[k]]
-        doc = f"{self.model.name}: {doc}; inputs {', '.join(f'{a} (..., {len(s)})' for a, s in args)}"
-        if self.parameters:
-            doc += f"; params = ({', '.join(s.name for s in self.parameters)})"
         return codegen.program(name, exprs, shape, args, trig, doc, polys=flat, values=rg.generator_values())
-
-    def to_function(self, name: str):
-        """NumPy function of a term, vectorised over leading batch dimensions:
-        ``M(q)``, ``C(q, qd)``, ``g(q)``, ``tau(q, qd, qdd)``, ... with arrays ``(..., n)``
-        (and ``params (..., len(parameters))`` when the model has free symbols)."""
-        return codegen.numpy_function(self.program(name))
-
-    def to_numba(self, name: str):
-        """Numba-compiled function of a term (same signature as :meth:`to_function`)."""
-        return codegen.numba_function(self.program(name))
-
-    def c_prefix(self) -> str:
-        return "".join(ch if ch.isalnum() else "_" for ch in self.model.name)
-
-    def to_c(self, directory=None, terms=("M", "C", "g", "tau")) -> dict:
-        """C source and header of ``terms``: ``{"NAME_dynamics.h": ..., "NAME_dynamics.c": ...}``,
-        written into ``directory`` when given. Each function is
-        ``void NAME_TERM(const double *q[, const double *qd, ...], double *out)`` with ``out``
-        row-major (see the header)."""
-        prefix = self.c_prefix()
-        base = f"{prefix}_dynamics"
-        progs = [self.program(t) for t in terms]
-        guard = base.upper() + "_H"
-        head = [f"/* Closed-form dynamics of {self.model.name!r} ({self.n} joints), derived by robodyn.symbolic",
-                f"   ({self.method.replace('_', '-')} method). M(q) qdd + C(q, qd) qd + g(q) = tau.",
-                "   Inputs are arrays of doubles: q, qd, qdd of length n"
-                + (f"; params = ({', '.join(s.name for s in self.parameters)})" if self.parameters else "")
-                + ". Outputs are row-major. */",
-                f"#ifndef {guard}", f"#define {guard}", "", f"#define {prefix.upper()}_NV {self.n}", ""]
-        for p in progs:
-            head += [f"/* {p.doc}; out has {max(1, len(p.outputs))} entries */", c_prototype_line(p, prefix), ""]
-        head += [f"#endif /* {guard} */", ""]
-        src = [f'/* Generated by robodyn.symbolic; see {base}.h */', "#include <math.h>",
-               f'#include "{base}.h"', ""]
-        src += [codegen.c_function(p, prefix) for p in progs]
-        files = {f"{base}.h": "\n".join(head), f"{base}.c": "\n".join(src)}
-        if directory is not None:
-            d = Path(directory)
-            d.mkdir(parents=True, exist_ok=True)
-            for k, v in files.items():
-                (d / k).write_text(v)
-        return files
 
     def latex(self, name: str | None = None) -> str:
         """LaTeX of one term (``name``), or with ``name=None`` a complete document with the
@@ -268,10 +225,6 @@ class EquationsOfMotion:
         if name is None:
             return document(self)
         return term_latex(self, name)
-
-
-def c_prototype_line(p, prefix):
-    return codegen.c_prototype(p, prefix) + ";"
 
 
 def equations_of_motion(model, method: str = "lagrange") -> EquationsOfMotion:

@@ -25,6 +25,13 @@ from ._spatial import (force_act, force_cross, inertia_mul, joint_placement, mot
 
 def derive(rg: TrigRing) -> dict:
     """``tau``, ``T``, ``U`` (ring polynomials) by the recursive Newton-Euler algorithm."""
+    tau, T = recursion(rg)
+    return dict(tau=tau, T=rg.reduce(T), U=potential_energy(rg, world_poses(rg)))
+
+
+def recursion(rg) -> tuple[list, object]:
+    """``(tau, T)``: the joint forces (n scalars of ``rg``: :class:`.TrigRing` polynomials,
+    or :class:`._emit.Emitter` intermediates) and the kinetic energy."""
     m, n = rg.model, rg.model.nv
     zero6 = [rg.zero] * 6
     a0 = [-x for x in rg.vec(m.gravity)] + [rg.zero] * 3
@@ -52,5 +59,4 @@ def derive(rg: TrigRing) -> dict:
         par = m.parent[i]
         if par >= 0:
             F[par] = [a + b for a, b in zip(F[par], force_act(rg, *X[i], F[i]))]
-    U = potential_energy(rg, world_poses(rg))
-    return dict(tau=tau, T=rg.reduce(T), U=U)
+    return tau, T
