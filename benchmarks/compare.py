@@ -27,7 +27,7 @@ import numba
 import numpy as np
 
 import robodyn as rd
-from robodyn.bench import Timing, batch_timings, format_table, per_call_us, single_call_timings
+from robodyn.bench import Timing, batch_timings, format_table, paired_us, per_call_us, single_call_timings
 
 HERE = Path(__file__).resolve().parent
 
@@ -65,8 +65,8 @@ def rtb_section(batch: int) -> str:
         rng = np.random.default_rng(0)
         q, v, a = rng.uniform(-1, 1, (3, model.nv))
         rows += [
-            Timing(f"{name} rne / rnea", per_call_us(lambda: rd.rnea(model, q, v, a)), per_call_us(lambda: robot.rne(q, v, a))),
-            Timing(f"{name} inertia / crba", per_call_us(lambda: rd.crba(model, q)), per_call_us(lambda: robot.inertia(q))),
+            Timing(f"{name} rne / rnea", *paired_us(lambda: rd.rnea(model, q, v, a), lambda: robot.rne(q, v, a))),
+            Timing(f"{name} inertia / crba", *paired_us(lambda: rd.crba(model, q), lambda: robot.inertia(q))),
             Timing(f"{name} coriolis", per_call_us(lambda: rd.coriolis_matrix(model, q, v)),
                    per_call_us(lambda: robot.coriolis(q, v), min_time=0.5, repeat=2)),
         ]

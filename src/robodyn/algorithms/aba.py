@@ -228,12 +228,13 @@ def finite_where(x, mask, value):
     return True
 
 
-@core
-def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
+@inline
+def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
     """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,) (RBDA section 9.2, see
     ``hybrid.py``). ``known[k]``: the acceleration of dof ``k`` is given (all dofs of a joint
     alike); with no dof known this is the ABA. Returns a status (see
-    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
+    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular. Inlined
+    into :func:`hybrid_one` (one state) and :func:`aba_range` (a batch loop).
 
     Every spatial quantity is in world coordinates, where articulated inertias and bias
     forces pass to the parent without a change of frame (``IA_p += Ia``, ``pA_p += pa``) and
@@ -351,6 +352,12 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
 
 
 @core
+def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
+    """:func:`hybrid_state` of one state (the compiled function other kernels call)."""
+    return hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws)
+
+
+@core
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
     known acceleration (``ws[17]`` is all False; ``ws[16]`` receives the copy of ``tau``).
@@ -359,14 +366,20 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[17], fext, fcode, check, qdd, ws[16], ws)
 
 
+@core
+def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
+    """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`)."""
+    for s in range(lo, hi):
+        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[17],
+                                 F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[16], ws)
+
+
 @parallel
 def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = aba_one(ints, body, dofs, params, Q[s], V[s], T[s], F[s if F.shape[0] > 1 else 0],
-                                fcode, check, QDD[s], ws)
+        aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, c * B // nchunk,
+                  (c + 1) * B // nchunk, workspace(ints.shape[0], dofs.shape[0]))
 
 
 @kernel

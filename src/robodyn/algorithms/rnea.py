@@ -20,12 +20,12 @@ import numpy as np
 from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
-from ..joint_kernels import friction_torque
+from ..joint_kernels import body_placement, friction_torque
 from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
-from .kinematics import placements, world_placements
+from .kinematics import world_placement
 
 
 @kernel
@@ -52,38 +52,53 @@ def motion_workspace(nb, nv):
 
 
 @inline
-def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
-    """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the
-    base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
+def base_acceleration(grav, a0):
+    """``a0 = [-grav; 0]``: gravity as a fictitious acceleration of the base (RBDA 5.3)."""
     for k in range(6):
         a0[k] = 0.0
     a0[0], a0[1], a0[2] = -grav[0], -grav[1], -grav[2]
+
+
+@inline
+def motion_step(i, par, dofs, iv, n, R, p, v, a, vel, acc, a0, vJ, t1):
+    """Velocity ``vel[i]`` and acceleration ``acc[i]`` of body ``i`` from its parent's (or
+    from the base acceleration ``a0`` for a root), ``(R, p)`` its placement in the parent:
+    ``v_i = iX_p v_p + S qd``, ``a_i = iX_p a_p + S qdd + v_i x S qd``."""
+    if par >= 0:
+        motion_act_inv(R, p, vel[par], vel[i])
+        motion_act_inv(R, p, acc[par], acc[i])
+    else:
+        vel[i, :] = 0.0
+        motion_act_inv(R, p, a0, acc[i])
+    for r in range(6):
+        vJ[r] = 0.0
+    for k in range(iv, iv + n):
+        for r in range(6):
+            vJ[r] += dofs[k, r] * v[k]
+            acc[i, r] += dofs[k, r] * a[k]
+    for r in range(6):
+        vel[i, r] += vJ[r]
+    motion_cross(vel[i], vJ, t1)
+    for r in range(6):
+        acc[i, r] += t1[r]
+
+
+@inline
+def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
+    """Body velocities ``vel`` and accelerations ``acc`` (nb, 6) in body coordinates, with the
+    base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
+    base_acceleration(grav, a0)
     for i in range(ints.shape[0]):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if par >= 0:
-            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
-            motion_act_inv(liR[i], lip[i], acc[par], acc[i])
-        else:
-            vel[i, :] = 0.0
-            motion_act_inv(liR[i], lip[i], a0, acc[i])
-        for r in range(6):
-            vJ[r] = 0.0
-        for k in range(iv, iv + n):
-            for r in range(6):
-                vJ[r] += dofs[k, r] * v[k]
-                acc[i, r] += dofs[k, r] * a[k]
-        for r in range(6):
-            vel[i, r] += vJ[r]
-        motion_cross(vel[i], vJ, t1)
-        for r in range(6):
-            acc[i, r] += t1[r]
+        motion_step(i, ints[i, 0], dofs, ints[i, 3], ints[i, 4], liR[i], lip[i], v, a, vel, acc, a0, vJ, t1)
 
 
-@core
-def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
+@inline
+def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
 
     ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
+    Inlined into :func:`rnea_one` (one state) and :func:`rnea_range` (a batch loop, where a
+    call per state would cost more than a tenth of the work).
     """
     _, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2 = ws
     nb, nv = ints.shape[0], dofs.shape[0]
@@ -91,12 +106,15 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
         return WRONG_SIZE
     if check and not (finite(q) and finite(v) and finite(a)):
         return NONFINITE
-    if not placements(ints, body, q, liR, lip, Rj, pj):
-        return BAD_QUATERNION
-    if fcode > 0:
-        world_placements(ints, liR, lip, oR, op)
-    motion_pass(ints, dofs, liR, lip, v, a, params, vel, acc, vJ, t1, t2)
+    # Pass 1 (one sweep from the root): placements, motion, body forces
+    base_acceleration(params, t2)
     for i in range(nb):
+        par = ints[i, 0]
+        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+            return BAD_QUATERNION
+        if fcode > 0:
+            world_placement(i, par, liR, lip, oR, op)
+        motion_step(i, par, dofs, ints[i, 3], ints[i, 4], liR[i], lip[i], v, a, vel, acc, t2, vJ, t1)
         theta = body[i, 15:25]
         inertia_mul(theta, acc[i], f[i])
         inertia_mul(theta, vel[i], t1)
@@ -123,14 +141,27 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     return result_status(check, finite(tau))
 
 
+@core
+def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
+    """:func:`rnea_state` of one state (the compiled function other kernels call)."""
+    return rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws)
+
+
+@core
+def rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, lo, hi, ws):
+    """:func:`rnea_state` of the states ``lo <= s < hi`` of a batch (``F`` has one row per
+    state, or a single row for all)."""
+    for s in range(lo, hi):
+        status[s] = rnea_state(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0],
+                               fcode, check, TAU[s], ws)
+
+
 @parallel
 def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = rnea_one(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0],
-                                 fcode, check, TAU[s], ws)
+        rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, c * B // nchunk,
+                   (c + 1) * B // nchunk, workspace(ints.shape[0]))
 
 
 @kernel
