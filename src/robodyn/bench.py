@@ -70,8 +70,8 @@ class Timing:
         return None if self.other_us is None else self.robodyn_us / self.other_us
 
 
-def per_call_us(fn, min_time: float = 0.2, repeat: int = 5) -> float:
-    """Best-of-``repeat`` time of one call of ``fn`` in microseconds."""
+def _calibrate(fn, min_time: float) -> tuple[int, float]:
+    """Calls of ``fn`` that take at least ``min_time`` s (up to a million), and their time."""
     fn()
     n = 1
     while True:
@@ -79,9 +79,14 @@ def per_call_us(fn, min_time: float = 0.2, repeat: int = 5) -> float:
         for _ in range(n):
             fn()
         dt = time.perf_counter() - t0
-        if dt > min_time / repeat or n > 1_000_000:
-            break
+        if dt > min_time or n > 1_000_000:
+            return n, dt
         n *= 4
+
+
+def per_call_us(fn, min_time: float = 0.2, repeat: int = 5) -> float:
+    """Best-of-``repeat`` time of one call of ``fn`` in microseconds."""
+    n, dt = _calibrate(fn, min_time / repeat)
     best = dt / n
     for _ in range(repeat - 1):
         t0 = time.perf_counter()
@@ -96,18 +101,7 @@ def paired_us(fn, other=None, min_time: float = 0.02, rounds: int = 15) -> tuple
     rounds so that both see the same machine load (on a shared machine the speed drifts
     between seconds; comparing minima of interleaved rounds keeps the ratio honest)."""
     fns = [f for f in (fn, other) if f is not None]
-    counts = []
-    for f in fns:  # calls per round: enough for ``min_time``
-        f()
-        n = 1
-        while True:
-            t0 = time.perf_counter()
-            for _ in range(n):
-                f()
-            if time.perf_counter() - t0 > min_time or n > 1_000_000:
-                break
-            n *= 4
-        counts.append(n)
+    counts = [_calibrate(f, min_time)[0] for f in fns]  # calls per round
     best = [float("inf")] * len(fns)
     for _ in range(rounds):
         for j, (f, n) in enumerate(zip(fns, counts)):
@@ -127,17 +121,22 @@ def states(model, batch: int, seed: int = 0):
     return (Q[0].copy(), V[0].copy(), A[0].copy()), (Q, V, A)
 
 
-def single_call_timings(model, pm=None, seed: int = 0) -> list[Timing]:
-    """Per-call times of robodyn (and Pinocchio's Python API if ``pm`` is given)."""
+def robodyn_calls(model, q, v, a, suffix: str = "") -> dict:
+    """The four timed calls on the states ``(q, v, a)`` (single or batched), by name."""
     import robodyn as rd
 
-    (q, v, a), _ = states(model, 1, seed)
-    calls = {
-        "rnea": lambda: rd.rnea(model, q, v, a),
-        "aba": lambda: rd.aba(model, q, v, a),
-        "crba": lambda: rd.crba(model, q),
-        "coriolis_matrix": lambda: rd.coriolis_matrix(model, q, v),
+    return {
+        "rnea" + suffix: lambda: rd.rnea(model, q, v, a),
+        "aba" + suffix: lambda: rd.aba(model, q, v, a),
+        "crba" + suffix: lambda: rd.crba(model, q),
+        "coriolis_matrix" + suffix: lambda: rd.coriolis_matrix(model, q, v),
     }
+
+
+def single_call_timings(model, pm=None, seed: int = 0) -> list[Timing]:
+    """Per-call times of robodyn (and Pinocchio's Python API if ``pm`` is given)."""
+    (q, v, a), _ = states(model, 1, seed)
+    calls = robodyn_calls(model, q, v, a)
     pin_calls = {}
     if pm is not None:  # the converted model has the same q layout (one angle per joint)
         import pinocchio as pin
@@ -155,17 +154,10 @@ def single_call_timings(model, pm=None, seed: int = 0) -> list[Timing]:
 def batch_timings(model, batch: int, pm=None, seed: int = 0) -> list[Timing]:
     """Per-state times of batched calls; Pinocchio's ``rneaInParallel``/``abaInParallel``
     with the same number of threads, and Python loops over ``crba``/``computeCoriolisMatrix``."""
-    import robodyn as rd
-
     _, (Q, V, A) = states(model, batch, seed)
     threads = numba.get_num_threads()
-    calls = {
-        "rnea (batch)": lambda: rd.rnea(model, Q, V, A),
-        "aba (batch)": lambda: rd.aba(model, Q, V, A),
-        "crba (batch)": lambda: rd.crba(model, Q),
-        "coriolis_matrix (batch)": lambda: rd.coriolis_matrix(model, Q, V),
-    }
-    others, n_other = {}, batch
+    calls = robodyn_calls(model, Q, V, A, " (batch)")
+    others = {}
     if pm is not None:
         import pinocchio as pin
 

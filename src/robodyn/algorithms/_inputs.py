@@ -110,12 +110,12 @@ def states(model, **arrays):
     ``arrays`` maps argument names (``q`` has length nq, every other one nv) to array-likes.
     Returns ``(batch_shape, out)``: for a single state (``batch_shape == ()``) ``out[name]``
     is a contiguous 1-D array, otherwise C-contiguous of shape ``(B, n)``,
-    ``B = prod(batch_shape)``.
+    ``B = prod(batch_shape)``; always writeable (read-only inputs are copied).
     """
     nq, nv = model.nq, model.nv
     for name, x in arrays.items():  # fast path: contiguous float64 vectors of the right size
         if not (type(x) is np.ndarray and x.dtype is _F8 and x.shape == ((nq,) if name == "q" else (nv,))
-                and x.strides == (8,)):
+                and x.strides == (8,) and x.flags.writeable):
             break
     else:
         return (), arrays
@@ -129,7 +129,7 @@ def states(model, **arrays):
         single = single and a.ndim == 1
         out[name] = a
     if single:
-        return (), {name: np.ascontiguousarray(a) for name, a in out.items()}
+        return (), {name: _kernel_layout(a) for name, a in out.items()}
     try:
         batch = np.broadcast_shapes(*(a.shape[:-1] for a in out.values()))
     except ValueError:
@@ -139,8 +139,15 @@ def states(model, **arrays):
     for name, a in out.items():
         if a.shape[:-1] != batch:
             a = np.broadcast_to(a, batch + a.shape[-1:])
-        out[name] = np.ascontiguousarray(a.reshape(B, a.shape[-1]))
+        out[name] = _kernel_layout(a.reshape(B, a.shape[-1]))
     return batch, out
+
+
+def _kernel_layout(a: np.ndarray) -> np.ndarray:
+    """``a`` C-contiguous and writeable (a copy if needed): the one array type the kernels are
+    compiled for, so that read-only or strided inputs do not compile new specialisations."""
+    a = np.ascontiguousarray(a)
+    return a if a.flags.writeable else a.copy()
 
 
 WRENCH_FRAMES = {"local": 0, "world": 1, "local_world_aligned": 2}

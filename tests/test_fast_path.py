@@ -1,0 +1,89 @@
+"""The single-state fast paths of rnea, aba, crba and coriolis_matrix (compiled for contiguous
+float64 vectors only) and the general path they fall back to: every other kind of input gives
+the same result, and the workspaces carved from one buffer never overrun it."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+import robodyn as rd
+from helpers import assert_rel
+from robodyn.algorithms._workspace import take
+from robodyn.random import random_model, random_state
+
+MODELS = [rd.models.load("panda"), random_model(6, seed=3, floating_base=True, branching=0.5)]
+CALLS = {
+    "rnea": lambda m, q, v, a, **kw: rd.rnea(m, q, v, a, **kw),
+    "aba": lambda m, q, v, a, **kw: rd.aba(m, q, v, a, **kw),
+    "crba": lambda m, q, v, a, **kw: rd.crba(m, q, **{k: x for k, x in kw.items() if k == "armature"}),
+    "coriolis_matrix": lambda m, q, v, a, **kw: rd.coriolis_matrix(m, q, v),
+}
+
+
+def variants(x):
+    """The same vector as a list, a read-only array, a strided view, float32-exact values
+    and a (1, n) batch (whose result has a leading dimension of one)."""
+    ro = x.copy()
+    ro.flags.writeable = False
+    strided = np.zeros(2 * x.size)[::2]
+    strided[:] = x
+    return {"list": x.tolist(), "read-only": ro, "strided": strided, "batch of one": x[None]}
+
+
+@pytest.mark.parametrize("model", MODELS, ids=["panda", "floating tree"])
+@pytest.mark.parametrize("name", list(CALLS))
+def test_every_input_kind_gives_the_fast_result(model, name):
+    call = CALLS[name]
+    q, v, a = random_state(model, np.random.default_rng(7))
+    expected = call(model, q, v, a)
+    for kind, (qx, vx, ax) in zip(variants(q), zip(*(variants(x).values() for x in (q, v, a)))):
+        got = call(model, qx, vx, ax)
+        if kind == "batch of one":
+            assert got.shape == (1,) + expected.shape
+            got = got[0]
+        assert_rel(got, expected, 1e-14, f"{name} with {kind} input")
+
+
+@pytest.mark.parametrize("name", ["rnea", "aba", "crba"])
+def test_integer_options_equal_booleans(name):
+    """friction=0/1, armature=0/1 mean False/True (they miss the fast path's bool lookup)."""
+    model = rd.models.load("puma560")
+    q, v, a = random_state(model, np.random.default_rng(1))
+    call = CALLS[name]
+    for f in (0, 1):
+        for arm in (0, 1):
+            assert_rel(call(model, q, v, a, friction=f, armature=arm),
+                       call(model, q, v, a, friction=bool(f), armature=bool(arm)), 0.0)
+    assert not np.allclose(call(model, q, v, a, armature=0), call(model, q, v, a, armature=1))
+
+
+def test_bad_sizes_and_values_still_raise_on_the_fast_path():
+    model = MODELS[0]
+    q, v, a = random_state(model, np.random.default_rng(2))
+    with pytest.raises(ValueError, match=r"q: expected shape"):
+        rd.rnea(model, np.zeros(model.nq + 1), v, a)
+    bad = a.copy()
+    bad[3] = np.nan
+    with pytest.raises(ValueError, match=r"a contains NaN"):
+        rd.rnea(model, q, v, bad)
+    with pytest.raises(ValueError, match=r"tau contains NaN"):
+        rd.aba(model, q, v, bad)
+
+
+@numba.njit
+def _carve(n_buffer, rows):
+    buf = np.empty(n_buffer)
+    first, o = take(buf, 0, (rows, 3))
+    second, o = take(buf, o, (2,))
+    first[rows - 1, 2] = 7.0
+    second[1] = 5.0
+    return buf, o
+
+
+def test_workspace_views_share_the_buffer_and_never_overrun_it():
+    buf, end = _carve(3 * 4 + 2, 4)
+    assert end == 14 and buf[11] == 7.0 and buf[13] == 5.0
+    with pytest.raises(IndexError, match="workspace buffer too small"):
+        _carve(3 * 4 + 1, 4)
