@@ -322,27 +322,6 @@ def motion_cross_matrix(m, out):
 
 
 @inline
-def wrench_to_world(frame, R, p, f, out):
-    """A wrench ``[force; torque]`` given in ``frame`` expressed in world coordinates (world
-    axes, torque about the world origin); ``(R, p)`` is the body's world placement.
-
-    ``frame`` 0: body frame; 1: already in world coordinates; 2: world axes, torque about the
-    body origin (``n_0 = n + p x f``).
-    """
-    if frame == 0:
-        force_act(R, p, f, out)
-    elif frame == 1:
-        for k in range(6):
-            out[k] = f[k]
-    else:
-        for k in range(3):
-            out[k] = f[k]
-        out[3] = f[3] + p[1] * f[2] - p[2] * f[1]
-        out[4] = f[4] + p[2] * f[0] - p[0] * f[2]
-        out[5] = f[5] + p[0] * f[1] - p[1] * f[0]
-
-
-@inline
 def wrench_to_local(frame, R, p, f, out):
     """A wrench ``[force; torque]`` given in ``frame`` expressed in the body frame ``(R, p)``.
 

@@ -2,19 +2,20 @@
 
     a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)
 
-Every spatial quantity is expressed in world coordinates (Pinocchio's choice since 2.x):
-articulated inertias then pass to the parent and accelerations to the child without a
-change of frame. ``oS_i`` are the joint's motion-subspace columns in the world frame.
+Pass 1 (root to leaves), in body coordinates: ``v_i = iX_p v_p + S_i qd_i``,
+``c_i = v_i x S_i qd_i``, ``IA_i = I_i``, ``pA_i = v_i x* I_i v_i - f_ext_i``.
 
-Pass 1 (root to leaves): ``v_i = v_p + oS_i qd_i``, ``c_i = v_i x oS_i qd_i``,
-``IA_i = oI_i`` (the body inertia in world coordinates), ``pA_i = v_i x* IA_i v_i - f_ext_i``.
+Pass 2 (leaves to root): ``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``,
+``u_i = tau_i - S_i^T pA_i (- friction)``; the articulated inertia
+``Ia = IA_i - U_i D_i^-1 U_i^T`` and bias ``pa = pA_i + Ia c_i + U_i D_i^-1 u_i`` are added to
+the parent: ``IA_p += iX_p^T Ia iX_p``, ``pA_p += iX_p^T pa``.
 
-Pass 2 (leaves to root): ``U_i = IA_i oS_i``, ``D_i = oS_i^T U_i (+ armature)``,
-``u_i = tau_i - oS_i^T pA_i (- friction)``; the parent receives
-``IA_p += IA_i - U_i D_i^-1 U_i^T`` and ``pA_p += pA_i + IA_i c_i + U_i D_i^-1 (u_i - U_i^T c_i)``.
+Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = iX_p a_p + c_i``,
+``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + S_i qdd_i``.
 
-Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = a_p + c_i``,
-``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + oS_i qdd_i``.
+Body coordinates rather than world coordinates: in world coordinates a light body far from
+the origin has a rotational inertia dominated by ``m |p|^2``, and ``D_i`` then loses digits
+to cancellation (measured: 100x larger errors on the iCub hands).
 
 A body whose ``D_i`` is singular (a massless leaf, a point mass on its joint axis) makes the
 forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
@@ -30,8 +31,8 @@ from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
-from ..spatial import (force_cross, inertia_act, inertia_matrix, inertia_mul, matvec6, motion_act, motion_cross,
-                       wrench_to_world)
+from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul, matvec6,
+                       motion_act_inv, motion_cross, wrench_to_local)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
@@ -43,12 +44,11 @@ SINGULAR_RTOL = 1e-12
 
 @kernel
 def workspace(nb, nv):
-    """Scratch of :func:`hybrid_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, vel, c, IA, pA, acc,
-    U, Dinv, u, UD, G, Iw, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy of
-    the joint forces and ``known`` is all False (no joint of known acceleration)."""
-    buf = np.empty((POSES_SIZE_NB + 60) * nb + 20 * nv + POSES_SIZE + 130)
+    """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
+    Dinv, u, UD, G, B3, PB, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
+    of the joint forces and ``known`` is all False (no joint of known acceleration)."""
+    buf = np.empty((POSES_SIZE_NB + 60) * nb + 14 * nv + POSES_SIZE + 192)
     P, o = poses(buf, 0, nb)
-    oS, o = take(buf, o, (nv, 6))
     vel, o = take(buf, o, (nb, 6))
     c, o = take(buf, o, (nb, 6))
     IA, o = take(buf, o, (nb, 6, 6))
@@ -59,11 +59,13 @@ def workspace(nb, nv):
     u, o = take(buf, o, (nv,))
     UD, o = take(buf, o, (6, 6))
     G, o = take(buf, o, (6, 12))
-    Iw, o = take(buf, o, (10,))
+    B3, o = take(buf, o, (3, 3, 3))
+    PB, o = take(buf, o, (3, 3))
+    Ia, o = take(buf, o, (6, 6))
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    return buf, P, oS, vel, c, IA, pA, acc, U, Dinv, u, UD, G, Iw, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
+    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, B3, PB, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
 
 
 @inline
@@ -149,20 +151,6 @@ def articulated_inertia(IA_i, U, Dinv, iv, n, UD, Ia):
 
 
 @inline
-def add_articulated_inertia(IA_i, U, UD, iv, n, IA_p):
-    """``IA_p += IA_i - UD U^T`` (all in one frame), computed on the upper triangle and
-    mirrored, so that ``IA_p`` stays exactly symmetric."""
-    for r in range(6):
-        for cc in range(r, 6):
-            s = IA_i[r, cc]
-            for j in range(n):
-                s -= UD[r, j] * U[iv + j, cc]
-            IA_p[r, cc] += s
-            if cc != r:
-                IA_p[cc, r] += s
-
-
-@inline
 def joint_acceleration(S, U, Dinv, u, iv, n, acc_i, qdd, t):
     """``qdd = D^-1 (u - U^T a_i)`` for one joint, then ``a_i += S qdd`` (``t`` (6,) scratch)."""
     for k in range(iv, iv + n):
@@ -181,12 +169,13 @@ def joint_acceleration(S, U, Dinv, u, iv, n, acc_i, qdd, t):
 
 
 @inline
-def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, par, IA, pA):
+def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, Ia, pa):
     """Pass 2 of the ABA for a joint of one dof ``iv`` (the common case, written out):
     ``U = IA_i S``, ``D = S^T U + armature``, ``u = tau_f - S^T pA_i`` (``tau_f``: the joint
-    force less friction), then, unless the body is a root, ``IA_p += IA_i - U U^T / D`` and
-    ``pA_p += pA_i + IA_i c_i + U (u - U^T c_i) / D``. ``t`` (6,) is scratch. Returns False
-    when ``D`` is singular (see :func:`joint_inertia`)."""
+    force less friction), the inertia passed to the parent ``Ia = IA_i - U U^T / D``
+    (symmetric by construction) and the bias force ``pa = pA_i + IA_i c_i + U (u - U^T c_i) / D``
+    (``= pA_i + Ia c_i + U u / D``). ``t`` (6,) is scratch. Returns False when ``D`` is
+    singular (see :func:`joint_inertia`)."""
     s0, s1, s2, s3, s4, s5 = S[0], S[1], S[2], S[3], S[4], S[5]
     c0, c1, c2, c3, c4, c5 = c_i[0], c_i[1], c_i[2], c_i[3], c_i[4], c_i[5]
     D, Uc, scale = armature, 0.0, 0.0
@@ -204,18 +193,14 @@ def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u,
     Dinv[iv, 0] = dinv
     uk = tau_f - (s0 * pA_i[0] + s1 * pA_i[1] + s2 * pA_i[2] + s3 * pA_i[3] + s4 * pA_i[4] + s5 * pA_i[5])
     u[iv] = uk
-    if par < 0:
-        return True
     uh = (uk - Uc) * dinv
     for r in range(6):
-        pA[par, r] += pA_i[r] + t[r] + U_k[r] * uh
-    for r in range(6):
+        pa[r] = pA_i[r] + t[r] + U_k[r] * uh
         ud = U_k[r] * dinv
         for cc in range(r, 6):
             x = IA_i[r, cc] - ud * U_k[cc]
-            IA[par, r, cc] += x
-            if cc != r:
-                IA[par, cc, r] += x
+            Ia[r, cc] = x
+            Ia[cc, r] = x
     return True
 
 
@@ -236,12 +221,10 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular. Inlined
     into :func:`hybrid_one` (one state) and :func:`aba_range` (a batch loop).
 
-    Every spatial quantity is in world coordinates, where articulated inertias and bias
-    forces pass to the parent without a change of frame (``IA_p += Ia``, ``pA_p += pa``) and
-    accelerations to the child likewise (``a_i = a_p + c_i``); ``oS`` are the world-frame
-    motion-subspace columns and ``c_i = v_i x oS_i qd_i`` (RBDA section 7.3 with every
-    coordinate transform the identity; Carpentier and Mansard 2018)."""
-    _, (liR, lip, oR, op, Rj, pj), oS, vel, c, IA, pA, acc, U, Dinv, u, UD, G, Iw, t1, t2, _, _ = ws
+    Spatial quantities are in body coordinates (RBDA Table 7.1), where the articulated
+    inertias keep the size of the bodies whatever their distance from the world origin."""
+    (_, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U, Dinv, u, UD, G, B3, PB, Ia, t1, t2,
+     _, _) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
             and tau_known.shape[0] == nv and known.shape[0] == nv):
@@ -256,76 +239,78 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
             return BAD_QUATERNION
-        world_placement(i, par, liR, lip, oR, op)
-        for k in range(iv, iv + n):
-            motion_act(oR[i], op[i], dofs[k, :6], oS[k])
+        if fcode > 0:
+            world_placement(i, par, liR, lip, oR, op)
+        if par >= 0:
+            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+        else:
+            vel[i, :] = 0.0
         for r in range(6):
             t1[r] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
-                t1[r] += oS[k, r] * v[k]
+                t1[r] += dofs[k, r] * v[k]
         for r in range(6):
-            vel[i, r] = t1[r] + (vel[par, r] if par >= 0 else 0.0)
+            vel[i, r] += t1[r]
         motion_cross(vel[i], t1, c[i])
         if known[iv]:
             for k in range(iv, iv + n):
                 for r in range(6):
-                    c[i, r] += oS[k, r] * qdd_known[k]
-        inertia_act(oR[i], op[i], body[i, 15:25], Iw)
-        inertia_matrix(Iw, IA[i])
-        inertia_mul(Iw, vel[i], t1)
+                    c[i, r] += dofs[k, r] * qdd_known[k]
+        theta = body[i, 15:25]
+        inertia_matrix(theta, IA[i])
+        inertia_mul(theta, vel[i], t1)
         force_cross(vel[i], t1, pA[i])
         if fcode >= 0:
-            wrench_to_world(fcode, oR[i], op[i], fext[i], t1)
+            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
                 pA[i, r] -= t1[r]
-    # Pass 2: articulated inertias, the joints of known acceleration held rigid
+    # Pass 2: articulated inertias, the joints of known acceleration held rigid; each body
+    # passes Ia and pa to its parent: IA_p += iX_p^T Ia iX_p, pA_p += iX_p^T pa
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if known[iv]:
-            if par >= 0:
-                matvec6(IA[i], c[i], t1)
-                for r in range(6):
-                    pA[par, r] += pA[i, r] + t1[r]
-                    for cc in range(6):
-                        IA[par, r, cc] += IA[i, r, cc]
-            continue
-        if n == 1:
-            if not articulate_single_dof(IA[i], oS[iv], dofs[iv, 6], c[i], pA[i],
-                                         tau_known[iv] - friction_torque(dofs, eps, v, iv),
-                                         iv, U[iv], Dinv, u, t1, par, IA, pA):
-                return i + 1
-            continue
-        for k in range(iv, iv + n):
-            s = 0.0
+            matvec6(IA[i], c[i], t1)
             for r in range(6):
-                s += oS[k, r] * pA[i, r]
-            u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
-        if not joint_inertia(IA[i], oS, dofs, iv, n, U, Dinv, G):
-            return i + 1
-        if par >= 0:
-            # pa = pA + Ia c + U D^-1 u = pA + IA c + U D^-1 (u - U^T c)
-            gain(U, Dinv, iv, n, UD)
+                t2[r] = pA[i, r] + t1[r]
+                for cc in range(6):
+                    Ia[r, cc] = IA[i, r, cc]
+        elif n == 1:
+            if not articulate_single_dof(IA[i], dofs[iv], dofs[iv, 6], c[i], pA[i],
+                                         tau_known[iv] - friction_torque(dofs, eps, v, iv),
+                                         iv, U[iv], Dinv, u, t1, Ia, t2):
+                return i + 1
+        else:
             for k in range(iv, iv + n):
                 s = 0.0
                 for r in range(6):
-                    s += U[k, r] * c[i, r]
-                t2[k - iv] = u[k] - s
-            matvec6(IA[i], c[i], t1)
+                    s += dofs[k, r] * pA[i, r]
+                u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
+            if not joint_inertia(IA[i], dofs, dofs, iv, n, U, Dinv, G):
+                return i + 1
+            if par < 0:
+                continue
+            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
+            matvec6(Ia, c[i], t1)
             for r in range(6):
                 s = pA[i, r] + t1[r]
                 for j in range(n):
-                    s += UD[r, j] * t2[j]
-                pA[par, r] += s
-            add_articulated_inertia(IA[i], U, UD, iv, n, IA[par])
+                    s += UD[r, j] * u[iv + j]
+                t2[r] = s
+        if par >= 0:
+            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
+            force_act(liR[i], lip[i], t2, t1)
+            for r in range(6):
+                pA[par, r] += t1[r]
     # Pass 3: accelerations of the joints of unknown acceleration, forces of the others
     for k in range(6):
         t2[k] = 0.0
     t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        motion_act_inv(liR[i], lip[i], acc[par] if par >= 0 else t2, acc[i])
         for r in range(6):
-            acc[i, r] = (acc[par, r] if par >= 0 else t2[r]) + c[i, r]
+            acc[i, r] += c[i, r]
         if known[iv]:
             matvec6(IA[i], acc[i], t1)
             for r in range(6):
@@ -334,7 +319,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 qdd[k] = qdd_known[k]
                 s = 0.0
                 for r in range(6):
-                    s += oS[k, r] * t1[r]
+                    s += dofs[k, r] * t1[r]
                 tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
             continue
         if n == 1:
@@ -343,9 +328,9 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 s += U[iv, r] * acc[i, r]
             qdd[iv] = Dinv[iv, 0] * (u[iv] - s)
             for r in range(6):
-                acc[i, r] += oS[iv, r] * qdd[iv]
+                acc[i, r] += dofs[iv, r] * qdd[iv]
         else:
-            joint_acceleration(oS, U, Dinv, u, iv, n, acc[i], qdd, t1)
+            joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):
             tau[k] = tau_known[k]
     return result_status(check, finite(qdd) and finite(tau))
@@ -360,18 +345,18 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
 @core
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
-    known acceleration (``ws[17]`` is all False; ``ws[16]`` receives the copy of ``tau``).
+    known acceleration (``ws[18]`` is all False; ``ws[17]`` receives the copy of ``tau``).
     Returns a status (see ``_inputs``): ``i + 1`` when the articulated inertia of body ``i``
     is singular."""
-    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[17], fext, fcode, check, qdd, ws[16], ws)
+    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[18], fext, fcode, check, qdd, ws[17], ws)
 
 
 @core
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
     """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`)."""
     for s in range(lo, hi):
-        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[17],
-                                 F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[16], ws)
+        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
+                                 F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
 
 
 @parallel

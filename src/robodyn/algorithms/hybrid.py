@@ -19,9 +19,6 @@ Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i = iX_p a_p + c_i``; unknown ac
 ``qdd_i = D_i^-1 (u_i - U_i^T a_i)``, ``a_i += S_i qdd_i``; known acceleration:
 ``tau_i = S_i^T (IA_i a_i + pA_i) (+ armature qdd_i + friction)``, the force transmitted by
 the joint to the articulated subtree beyond it.
-
-The kernel (``aba.hybrid_one``) works in world coordinates, where every ``iX_p`` above is
-the identity.
 """
 
 from __future__ import annotations
