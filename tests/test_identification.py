@@ -16,7 +16,7 @@ from robodyn.cli import main
 from robodyn.identification.identify import METHODS
 from robodyn.identification.estimation import log_cholesky, theta_jacobian, theta_of_log_cholesky
 from robodyn.model import check_inertial_parameters
-from helpers import PLANAR_2R, assert_rel, planar_2r, random_model, random_models, rng_for
+from helpers import PLANAR_2R, assert_rel, planar_2r, random_models, rng_for
 
 
 # -- base parameters --------------------------------------------------------------------------

@@ -288,7 +288,7 @@ def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
     nq, nv, nz = Q.shape[1], V.shape[1], Z.shape[1]
     n = Q.shape[0] - 1
     zero = np.zeros(nv)
-    qi, tau, a = np.empty(nq), np.empty(nv), np.empty(nv)
+    qi, tau = np.empty(nq), np.empty(nv)
     dy = np.empty(2 * nv + nz)
     Q[0], V[0] = q0, v0
     every = max(1, n // 100)
