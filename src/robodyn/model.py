@@ -347,7 +347,10 @@ class Model:
     def _pack(self) -> dict:
         """Arrays handed to the compiled kernels (few arguments, contiguous, read-only).
 
-        ``ints`` (nb, 5): parent, joint type, idx_q, idx_v, nv of the joint;
+        ``ints`` (nb, 6): parent, joint type, idx_q, idx_v, nv of the joint, and the axis code:
+        ``r`` when the joint has one dof whose motion subspace is the unit vector ``e_r`` of
+        the body frame (most URDF joints: the kernels then skip the products with zeros),
+        else -1;
         ``body`` (nb, 52): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10), joint
         constants (27, ``joints.joint_constants``);
         ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
@@ -359,7 +362,7 @@ class Model:
         argument costs Numba's dispatcher about 0.1 us (``_inputs.unpack`` takes it apart).
         """
         nb, nv = self.nbodies, self.nv
-        ints = np.zeros((nb, 5), dtype=np.int64)
+        ints = np.zeros((nb, 6), dtype=np.int64)
         ints[:, 0] = self.parent
         ints[:, 1] = self.joint_type
         ints[:, 2] = self.idx_q
@@ -378,6 +381,10 @@ class Model:
             Si = J.motion_subspace(int(self.joint_type[i]), self.joint_axis[i])
             full[k:k + Si.shape[0], :6] = Si
         full[:, 6], full[:, 7], full[:, 8] = self.armature, self.damping, self.coulomb
+        for i in range(nb):
+            S = full[self.idx_v[i], :6]
+            unit = ints[i, 4] == 1 and np.count_nonzero(S) == 1 and S.max() == 1.0
+            ints[i, 5] = int(np.argmax(S)) if unit else -1
         dofs = {}
         for friction in (False, True):
             for armature in (False, True):

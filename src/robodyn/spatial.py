@@ -134,6 +134,29 @@ def motion_cross(m, n, out):
 
 
 @inline
+def cross_unit(x0, x1, x2, j, s, out, o):
+    """``out[o:o + 3] = x x (s e_j)`` for the unit vector ``e_j`` (j = 0, 1, 2)."""
+    if j == 0:
+        out[o], out[o + 1], out[o + 2] = 0.0, x2 * s, -x1 * s
+    elif j == 1:
+        out[o], out[o + 1], out[o + 2] = -x2 * s, 0.0, x0 * s
+    else:
+        out[o], out[o + 1], out[o + 2] = x1 * s, -x0 * s, 0.0
+
+
+@inline
+def motion_cross_unit(m, r, s, out):
+    """``out = m x (s e_r)``: :func:`motion_cross` with a multiple of the unit motion ``e_r``
+    (``r`` < 3: a translation, else a rotation about axis ``r - 3``)."""
+    if r < 3:
+        cross_unit(m[3], m[4], m[5], r, s, out, 0)
+        out[3], out[4], out[5] = 0.0, 0.0, 0.0
+    else:
+        cross_unit(m[0], m[1], m[2], r - 3, s, out, 0)
+        cross_unit(m[3], m[4], m[5], r - 3, s, out, 3)
+
+
+@inline
 def force_cross(m, f, out):
     """Dual cross product, ``out = m x* f = [w x f; w x n + v x f]``."""
     v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]

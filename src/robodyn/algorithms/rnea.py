@@ -21,7 +21,8 @@ from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
-from ..spatial import force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, wrench_to_local
+from ..spatial import (force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, motion_cross_unit,
+                       wrench_to_local)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
@@ -60,16 +61,24 @@ def base_acceleration(grav, a0):
 
 
 @inline
-def motion_step(i, par, dofs, iv, n, R, p, v, a, vel, acc, a0, vJ, t1):
+def motion_step(i, par, dofs, iv, n, axis, R, p, v, a, vel, acc, a0, vJ, t1):
     """Velocity ``vel[i]`` and acceleration ``acc[i]`` of body ``i`` from its parent's (or
     from the base acceleration ``a0`` for a root), ``(R, p)`` its placement in the parent:
-    ``v_i = iX_p v_p + S qd``, ``a_i = iX_p a_p + S qdd + v_i x S qd``."""
+    ``v_i = iX_p v_p + S qd``, ``a_i = iX_p a_p + S qdd + v_i x S qd``; ``axis`` >= 0 when
+    ``S = e_axis`` (see ``Model._pack``)."""
     if par >= 0:
         motion_act_inv(R, p, vel[par], vel[i])
         motion_act_inv(R, p, acc[par], acc[i])
     else:
         vel[i, :] = 0.0
         motion_act_inv(R, p, a0, acc[i])
+    if axis >= 0:
+        vel[i, axis] += v[iv]
+        acc[i, axis] += a[iv]
+        motion_cross_unit(vel[i], axis, v[iv], t1)
+        for r in range(6):
+            acc[i, r] += t1[r]
+        return
     for r in range(6):
         vJ[r] = 0.0
     for k in range(iv, iv + n):
@@ -89,7 +98,8 @@ def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
     base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
     base_acceleration(grav, a0)
     for i in range(ints.shape[0]):
-        motion_step(i, ints[i, 0], dofs, ints[i, 3], ints[i, 4], liR[i], lip[i], v, a, vel, acc, a0, vJ, t1)
+        motion_step(i, ints[i, 0], dofs, ints[i, 3], ints[i, 4], ints[i, 5], liR[i], lip[i], v, a, vel, acc, a0,
+                    vJ, t1)
 
 
 @inline
@@ -114,7 +124,7 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
             return BAD_QUATERNION
         if fcode > 0:
             world_placement(i, par, liR, lip, oR, op)
-        motion_step(i, par, dofs, ints[i, 3], ints[i, 4], liR[i], lip[i], v, a, vel, acc, t2, vJ, t1)
+        motion_step(i, par, dofs, ints[i, 3], ints[i, 4], ints[i, 5], liR[i], lip[i], v, a, vel, acc, t2, vJ, t1)
         theta = body[i, 15:25]
         inertia_mul(theta, acc[i], f[i])
         inertia_mul(theta, vel[i], t1)
@@ -128,11 +138,14 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     # Pass 2: joint torques and forces transmitted to the parents
     eps = params[3]
     for i in range(nb - 1, -1, -1):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n, axis = ints[i, 0], ints[i, 3], ints[i, 4], ints[i, 5]
         for k in range(iv, iv + n):
-            s = 0.0
-            for r in range(6):
-                s += dofs[k, r] * f[i, r]
+            if axis >= 0:
+                s = f[i, axis]
+            else:
+                s = 0.0
+                for r in range(6):
+                    s += dofs[k, r] * f[i, r]
             tau[k] = s + dofs[k, 6] * a[k] + friction_torque(dofs, eps, v, k)
         if par >= 0:
             force_act(liR[i], lip[i], f[i], t1)
