@@ -31,6 +31,9 @@ kernel = njit(**_BASE)
 parallel = njit(parallel=True, **_BASE)
 core = njit(_nrt=False, **_BASE)
 inline = njit(inline="always", _nrt=False, **_BASE)
+# ``exact``: contraction (fused multiply-add) only, for code whose order of operations
+# carries its accuracy (``sincos``); LLVM may still inline it, the flags stay per operation.
+exact = njit(_nrt=False, **{**_BASE, "fastmath": {"contract"}})
 
 
 VEC = _types.Array(_types.float64, 1, "C")

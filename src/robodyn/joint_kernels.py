@@ -8,6 +8,7 @@ import numpy as np
 
 from ._jit import inline
 from .joints import PRISMATIC, QUAT_TOL, REVOLUTE, ROW_JOINT, ROW_XTREE_P
+from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
 
@@ -20,8 +21,7 @@ def body_placement(jtype, row, q, iq, R, p, Rj):
     (a near-unit quaternion is normalised).
     """
     if jtype == REVOLUTE:
-        c = np.cos(q[iq])
-        s = np.sin(q[iq])
+        s, c = sincos(q[iq])
         for r in range(3):
             p[r] = row[ROW_XTREE_P + r]
             for k in range(3):
