@@ -122,6 +122,37 @@ def force_act_inv(R, p, f, out):
 
 
 @inline
+def rotate6(R, x, out):
+    """``out = [R x_lin; R x_ang]``: a motion or force vector turned by ``R`` (no translation)."""
+    for o in (0, 3):
+        x0, x1, x2 = x[o], x[o + 1], x[o + 2]
+        for r in range(3):
+            out[o + r] = R[r, 0] * x0 + R[r, 1] * x1 + R[r, 2] * x2
+
+
+@inline
+def shift_motion(d, m, out):
+    """A motion vector at a point moved to the point ``d`` from it, axes unchanged:
+    ``[v - d x w; w]`` (:func:`motion_act_inv` with ``R = 1``)."""
+    w0, w1, w2 = m[3], m[4], m[5]
+    out[0] = m[0] - (d[1] * w2 - d[2] * w1)
+    out[1] = m[1] - (d[2] * w0 - d[0] * w2)
+    out[2] = m[2] - (d[0] * w1 - d[1] * w0)
+    out[3], out[4], out[5] = w0, w1, w2
+
+
+@inline
+def unshift_force(d, f, out):
+    """A force vector about the point ``d`` moved back about the first point, axes unchanged:
+    ``[f; n + d x f]`` (:func:`force_act` with ``R = 1``)."""
+    f0, f1, f2 = f[0], f[1], f[2]
+    out[0], out[1], out[2] = f0, f1, f2
+    out[3] = f[3] + d[1] * f2 - d[2] * f1
+    out[4] = f[4] + d[2] * f0 - d[0] * f2
+    out[5] = f[5] + d[0] * f1 - d[1] * f0
+
+
+@inline
 def motion_cross(m, n, out):
     """Spatial cross product of motions, ``out = m x n = [w x v' + v x w'; w x w']``."""
     v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
@@ -131,6 +162,14 @@ def motion_cross(m, n, out):
     out[3] = w1 * n[5] - w2 * n[4]
     out[4] = w2 * n[3] - w0 * n[5]
     out[5] = w0 * n[4] - w1 * n[3]
+
+
+@inline
+def cross_into(a0, a1, a2, b0, b1, b2, out, o):
+    """``out[o:o + 3] = a x b``."""
+    out[o] = a1 * b2 - a2 * b1
+    out[o + 1] = a2 * b0 - a0 * b2
+    out[o + 2] = a0 * b1 - a1 * b0
 
 
 @inline
@@ -186,19 +225,13 @@ def inertia_mul(theta, m, out):
 
 
 @inline
-def inertia_act(R, p, theta, out):
-    """Inertial parameters of a body expressed in the parent frame of placement ``(R, p)``.
-
-    ``h' = R h + m p``;
-    ``I' = R I R^T - p h_r^T - h_r p^T + 2 (p . h_r) 1 - m p p^T + m |p|^2 1`` with
-    ``h_r = R h`` (parallel-axis theorem without dividing by the mass).
-    """
+def inertia_rotate(R, theta, out):
+    """Inertial parameters of a body turned by the rotation ``R`` about the frame origin:
+    ``h' = R h``, ``I' = R I R^T``."""
     mass = theta[0]
-    hr0 = R[0, 0] * theta[1] + R[0, 1] * theta[2] + R[0, 2] * theta[3]
-    hr1 = R[1, 0] * theta[1] + R[1, 1] * theta[2] + R[1, 2] * theta[3]
-    hr2 = R[2, 0] * theta[1] + R[2, 1] * theta[2] + R[2, 2] * theta[3]
+    h0, h1, h2 = theta[1], theta[2], theta[3]
     ixx, ixy, iyy, ixz, iyz, izz = theta[4], theta[5], theta[6], theta[7], theta[8], theta[9]
-    # A = I R^T, then J = R A
+    # A = I R^T, then R A
     a00 = ixx * R[0, 0] + ixy * R[0, 1] + ixz * R[0, 2]
     a01 = ixx * R[1, 0] + ixy * R[1, 1] + ixz * R[1, 2]
     a02 = ixx * R[2, 0] + ixy * R[2, 1] + ixz * R[2, 2]
@@ -208,25 +241,40 @@ def inertia_act(R, p, theta, out):
     a20 = ixz * R[0, 0] + iyz * R[0, 1] + izz * R[0, 2]
     a21 = ixz * R[1, 0] + iyz * R[1, 1] + izz * R[1, 2]
     a22 = ixz * R[2, 0] + iyz * R[2, 1] + izz * R[2, 2]
-    j00 = R[0, 0] * a00 + R[0, 1] * a10 + R[0, 2] * a20
-    j01 = R[0, 0] * a01 + R[0, 1] * a11 + R[0, 2] * a21
-    j02 = R[0, 0] * a02 + R[0, 1] * a12 + R[0, 2] * a22
-    j11 = R[1, 0] * a01 + R[1, 1] * a11 + R[1, 2] * a21
-    j12 = R[1, 0] * a02 + R[1, 1] * a12 + R[1, 2] * a22
-    j22 = R[2, 0] * a02 + R[2, 1] * a12 + R[2, 2] * a22
+    out[0] = mass
+    out[1] = R[0, 0] * h0 + R[0, 1] * h1 + R[0, 2] * h2
+    out[2] = R[1, 0] * h0 + R[1, 1] * h1 + R[1, 2] * h2
+    out[3] = R[2, 0] * h0 + R[2, 1] * h1 + R[2, 2] * h2
+    out[4] = R[0, 0] * a00 + R[0, 1] * a10 + R[0, 2] * a20
+    out[5] = R[0, 0] * a01 + R[0, 1] * a11 + R[0, 2] * a21
+    out[6] = R[1, 0] * a01 + R[1, 1] * a11 + R[1, 2] * a21
+    out[7] = R[0, 0] * a02 + R[0, 1] * a12 + R[0, 2] * a22
+    out[8] = R[1, 0] * a02 + R[1, 1] * a12 + R[1, 2] * a22
+    out[9] = R[2, 0] * a02 + R[2, 1] * a12 + R[2, 2] * a22
+
+
+@inline
+def inertia_act(R, p, theta, out):
+    """Inertial parameters of a body expressed in the parent frame of placement ``(R, p)``.
+
+    ``h' = R h + m p``;
+    ``I' = R I R^T - p h_r^T - h_r p^T + 2 (p . h_r) 1 - m p p^T + m |p|^2 1`` with
+    ``h_r = R h`` (parallel-axis theorem without dividing by the mass).
+    """
+    inertia_rotate(R, theta, out)
+    mass, hr0, hr1, hr2 = out[0], out[1], out[2], out[3]
     p0, p1, p2 = p[0], p[1], p[2]
     ph = p0 * hr0 + p1 * hr1 + p2 * hr2
     pp = p0 * p0 + p1 * p1 + p2 * p2
-    out[0] = mass
     out[1] = hr0 + mass * p0
     out[2] = hr1 + mass * p1
     out[3] = hr2 + mass * p2
-    out[4] = j00 - 2.0 * p0 * hr0 + 2.0 * ph - mass * p0 * p0 + mass * pp
-    out[5] = j01 - p0 * hr1 - hr0 * p1 - mass * p0 * p1
-    out[6] = j11 - 2.0 * p1 * hr1 + 2.0 * ph - mass * p1 * p1 + mass * pp
-    out[7] = j02 - p0 * hr2 - hr0 * p2 - mass * p0 * p2
-    out[8] = j12 - p1 * hr2 - hr1 * p2 - mass * p1 * p2
-    out[9] = j22 - 2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
+    out[4] += -2.0 * p0 * hr0 + 2.0 * ph - mass * p0 * p0 + mass * pp
+    out[5] += -p0 * hr1 - hr0 * p1 - mass * p0 * p1
+    out[6] += -2.0 * p1 * hr1 + 2.0 * ph - mass * p1 * p1 + mass * pp
+    out[7] += -p0 * hr2 - hr0 * p2 - mass * p0 * p2
+    out[8] += -p1 * hr2 - hr1 * p2 - mass * p1 * p2
+    out[9] += -2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
 
 
 @inline
@@ -322,6 +370,61 @@ def congruence_to_parent(R, p, A, B, PB, out):
 
 
 @inline
+def congruence_shift(d, A, out):
+    """``out += X^T A X`` for a symmetric 6 x 6 ``A`` at the point ``d`` and ``X`` the shift
+    by ``d`` (:func:`congruence_to_parent` with ``R = 1``). With ``P = [d]x``:
+    ``X^T A X = [[A11, C], [C^T, A22 + (P A12)^T + P C]]``, ``C = A12 - A11 P``."""
+    d0, d1, d2 = d[0], d[1], d[2]
+    # C = A12 - A11 P: row r of A11 P is (row r of A11) x d
+    c00 = A[0, 3] - (A[0, 1] * d2 - A[0, 2] * d1)
+    c01 = A[0, 4] - (A[0, 2] * d0 - A[0, 0] * d2)
+    c02 = A[0, 5] - (A[0, 0] * d1 - A[0, 1] * d0)
+    c10 = A[1, 3] - (A[1, 1] * d2 - A[1, 2] * d1)
+    c11 = A[1, 4] - (A[1, 2] * d0 - A[1, 0] * d2)
+    c12 = A[1, 5] - (A[1, 0] * d1 - A[1, 1] * d0)
+    c20 = A[2, 3] - (A[2, 1] * d2 - A[2, 2] * d1)
+    c21 = A[2, 4] - (A[2, 2] * d0 - A[2, 0] * d2)
+    c22 = A[2, 5] - (A[2, 0] * d1 - A[2, 1] * d0)
+    # E = (P A12)^T + P C: column c of P Y is d x (column c of Y); (P A12)^T[r, c] = (P A12)[c, r]
+    e00 = (d1 * A[2, 3] - d2 * A[1, 3]) + (d1 * c20 - d2 * c10)
+    e01 = (d2 * A[0, 3] - d0 * A[2, 3]) + (d1 * c21 - d2 * c11)
+    e02 = (d0 * A[1, 3] - d1 * A[0, 3]) + (d1 * c22 - d2 * c12)
+    e11 = (d2 * A[0, 4] - d0 * A[2, 4]) + (d2 * c01 - d0 * c21)
+    e12 = (d0 * A[1, 4] - d1 * A[0, 4]) + (d2 * c02 - d0 * c22)
+    e22 = (d0 * A[1, 5] - d1 * A[0, 5]) + (d0 * c12 - d1 * c02)
+    for r in range(3):
+        for cc in range(3):
+            out[r, cc] += A[r, cc]
+    out[0, 3] += c00
+    out[0, 4] += c01
+    out[0, 5] += c02
+    out[1, 3] += c10
+    out[1, 4] += c11
+    out[1, 5] += c12
+    out[2, 3] += c20
+    out[2, 4] += c21
+    out[2, 5] += c22
+    out[3, 0] += c00
+    out[4, 0] += c01
+    out[5, 0] += c02
+    out[3, 1] += c10
+    out[4, 1] += c11
+    out[5, 1] += c12
+    out[3, 2] += c20
+    out[4, 2] += c21
+    out[5, 2] += c22
+    out[3, 3] += A[3, 3] + e00
+    out[3, 4] += A[3, 4] + e01
+    out[4, 3] += A[4, 3] + e01
+    out[3, 5] += A[3, 5] + e02
+    out[5, 3] += A[5, 3] + e02
+    out[4, 4] += A[4, 4] + e11
+    out[4, 5] += A[4, 5] + e12
+    out[5, 4] += A[5, 4] + e12
+    out[5, 5] += A[5, 5] + e22
+
+
+@inline
 def motion_cross_matrix(m, out):
     """6 x 6 matrix of ``n -> m x n``."""
     for r in range(6):
@@ -360,3 +463,19 @@ def wrench_to_local(frame, R, p, f, out):
         for r in range(3):
             out[r] = R[0, r] * f[0] + R[1, r] * f[1] + R[2, r] * f[2]
             out[r + 3] = R[0, r] * f[3] + R[1, r] * f[4] + R[2, r] * f[5]
+
+
+@inline
+def wrench_to_aligned(frame, R, p, f, out):
+    """A wrench ``[force; torque]`` given in ``frame`` (codes of :func:`wrench_to_local`)
+    expressed with world axes about the origin of the body placed at ``(R, p)``."""
+    if frame == 0:
+        rotate6(R, f, out)
+    elif frame == 1:
+        out[0], out[1], out[2] = f[0], f[1], f[2]
+        out[3] = f[3] - (p[1] * f[2] - p[2] * f[1])
+        out[4] = f[4] - (p[2] * f[0] - p[0] * f[2])
+        out[5] = f[5] - (p[0] * f[1] - p[1] * f[0])
+    else:
+        for k in range(6):
+            out[k] = f[k]

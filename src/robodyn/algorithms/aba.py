@@ -2,7 +2,7 @@
 
     a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)
 
-Pass 1 (root to leaves), in body coordinates: ``v_i = iX_p v_p + S_i qd_i``,
+Pass 1 (root to leaves): ``v_i = iX_p v_p + S_i qd_i``,
 ``c_i = v_i x S_i qd_i``, ``IA_i = I_i``, ``pA_i = v_i x* I_i v_i - f_ext_i``.
 
 Pass 2 (leaves to root): ``U_i = IA_i S_i``, ``D_i = S_i^T U_i (+ armature)``,
@@ -13,9 +13,14 @@ the parent: ``IA_p += iX_p^T Ia iX_p``, ``pA_p += iX_p^T pa``.
 Pass 3 (root to leaves), with ``a_0 = -g``: ``a_i' = iX_p a_p + c_i``,
 ``qdd_i = D_i^-1 (u_i - U_i^T a_i')``, ``a_i = a_i' + S_i qdd_i``.
 
-Body coordinates rather than world coordinates: in world coordinates a light body far from
-the origin has a rotational inertia dominated by ``m |p|^2``, and ``D_i`` then loses digits
-to cancellation (measured on the iCub hands: 10-100x larger errors than in body coordinates).
+Coordinates: each body's quantities are expressed at the body's origin with the world's
+axes. A transform between parent and child is then a pure shift by the vector ``d_i``
+between their origins, and the inertia passed to the parent costs a third of a rotated one
+(:func:`robodyn.spatial.congruence_shift`); the rotation is applied once per body, to its
+rigid inertia and motion subspace. World coordinates would save the shifts too, but there a
+light body far from the origin has a rotational inertia dominated by ``m |p|^2``, and
+``D_i`` loses digits to cancellation (measured on the iCub hands: 10-100x larger errors);
+about each body's own origin the inertias keep the size of the bodies.
 
 A body whose ``D_i`` is singular (a massless leaf, a point mass on its joint axis) makes the
 forward dynamics undefined: ``aba`` raises ``ValueError`` naming it.
@@ -31,12 +36,11 @@ from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
-from ..spatial import (congruence_to_parent, force_act, force_cross, inertia_matrix, inertia_mul, matvec6,
-                       motion_act_inv, motion_cross, wrench_to_local)
+from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_mul, inertia_rotate, matvec6,
+                       motion_cross, rotate6, shift_motion, unshift_force, wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
-from .kinematics import world_placement
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -45,9 +49,9 @@ SINGULAR_RTOL = 1e-12
 @kernel
 def workspace(nb, nv):
     """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
-    Dinv, u, UD, G, B3, PB, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
-    of the joint forces and ``known`` is all False (no joint of known acceleration)."""
-    buf = np.empty((POSES_SIZE_NB + 60) * nb + 14 * nv + POSES_SIZE + 192)
+    Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known, theta)``; ``tau`` receives :func:`aba_one`'s
+    copy of the joint forces and ``known`` is all False (no joint of known acceleration)."""
+    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 166)
     P, o = poses(buf, 0, nb)
     vel, o = take(buf, o, (nb, 6))
     c, o = take(buf, o, (nb, 6))
@@ -59,13 +63,14 @@ def workspace(nb, nv):
     u, o = take(buf, o, (nv,))
     UD, o = take(buf, o, (6, 6))
     G, o = take(buf, o, (6, 12))
-    B3, o = take(buf, o, (3, 3, 3))
-    PB, o = take(buf, o, (3, 3))
+    d, o = take(buf, o, (nb, 3))
+    S, o = take(buf, o, (nv, 6))
     Ia, o = take(buf, o, (6, 6))
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, B3, PB, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
+    theta, o = take(buf, o, (10,))
+    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_), theta
 
 
 @inline
@@ -163,29 +168,33 @@ def joint_acceleration(S, U, Dinv, u, iv, n, acc_i, qdd, t):
 
 
 @inline
-def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, Ia, pa):
+def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, Ia, pa, lo, hi):
     """Pass 2 of the ABA for a joint of one dof ``iv`` (the common case, written out):
     ``U = IA_i S``, ``D = S^T U + armature``, ``u = tau_f - S^T pA_i`` (``tau_f``: the joint
     force less friction), the inertia passed to the parent ``Ia = IA_i - U U^T / D``
     (symmetric by construction) and the bias force ``pa = pA_i + IA_i c_i + U (u - U^T c_i) / D``
-    (``= pA_i + Ia c_i + U u / D``). ``t`` (6,) is scratch. Returns False when ``D`` is
-    singular (see :func:`joint_inertia`)."""
-    s0, s1, s2, s3, s4, s5 = S[0], S[1], S[2], S[3], S[4], S[5]
+    (``= pA_i + Ia c_i + U u / D``). ``S`` is zero outside ``lo <= r < hi`` (``(3, 6)``: a
+    rotation about an axis through the origin, ``(0, 3)``: a translation, ``(0, 6)``: any
+    motion); callers pass constants, so the loops unroll. ``t`` (6,) is scratch. Returns False
+    when ``D`` is singular (see :func:`joint_inertia`)."""
     c0, c1, c2, c3, c4, c5 = c_i[0], c_i[1], c_i[2], c_i[3], c_i[4], c_i[5]
-    D, Uc, scale = armature, 0.0, 0.0
+    D, Uc, scale, Sp = armature, 0.0, 0.0, 0.0
     for r in range(6):
-        a0, a1, a2, a3, a4, a5 = IA_i[r, 0], IA_i[r, 1], IA_i[r, 2], IA_i[r, 3], IA_i[r, 4], IA_i[r, 5]
-        ur = a0 * s0 + a1 * s1 + a2 * s2 + a3 * s3 + a4 * s4 + a5 * s5
+        ur = 0.0
+        for j in range(lo, hi):
+            ur += IA_i[r, j] * S[j]
         U_k[r] = ur
-        t[r] = a0 * c0 + a1 * c1 + a2 * c2 + a3 * c3 + a4 * c4 + a5 * c5
-        D += S[r] * ur
+        t[r] = IA_i[r, 0] * c0 + IA_i[r, 1] * c1 + IA_i[r, 2] * c2 + IA_i[r, 3] * c3 + IA_i[r, 4] * c4 + IA_i[r, 5] * c5
         Uc += ur * c_i[r]
         scale += abs(IA_i[r, r])
+    for j in range(lo, hi):
+        D += S[j] * U_k[j]
+        Sp += S[j] * pA_i[j]
     if abs(D) <= SINGULAR_RTOL * scale:
         return False
     dinv = 1.0 / D
     Dinv[iv, 0] = dinv
-    uk = tau_f - (s0 * pA_i[0] + s1 * pA_i[1] + s2 * pA_i[2] + s3 * pA_i[3] + s4 * pA_i[4] + s5 * pA_i[5])
+    uk = tau_f - Sp
     u[iv] = uk
     uh = (uk - Uc) * dinv
     for r in range(6):
@@ -199,12 +208,64 @@ def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u,
 
 
 @inline
+def joint_motion(i, iv, n, axis, R, dofs, v, S, vJ, vel_i, c_i):
+    """Motion subspace ``S[k]`` of body ``i`` in world axes (``R`` its world rotation), the
+    joint velocity ``vJ = S qd`` added to ``vel_i``, and ``c_i = vel_i x vJ``. ``axis`` >= 0
+    when the joint's ``S`` is the unit motion ``e_axis`` (see ``Model._pack``): then ``S``
+    is a column of ``R`` in one half and zero in the other."""
+    if axis >= 0:
+        lo, col, qd = (0, axis, v[iv]) if axis < 3 else (3, axis - 3, v[iv])
+        for r in range(6):
+            S[iv, r] = 0.0
+            vJ[r] = 0.0
+        for r in range(3):
+            S[iv, lo + r] = R[r, col]
+            vJ[lo + r] = R[r, col] * qd
+            vel_i[lo + r] += vJ[lo + r]
+        if lo == 3:  # vel x [0; w] = [v x w; omega x w]
+            cross_into(vel_i[0], vel_i[1], vel_i[2], vJ[3], vJ[4], vJ[5], c_i, 0)
+            cross_into(vel_i[3], vel_i[4], vel_i[5], vJ[3], vJ[4], vJ[5], c_i, 3)
+        else:  # vel x [v; 0] = [omega x v; 0]
+            cross_into(vel_i[3], vel_i[4], vel_i[5], vJ[0], vJ[1], vJ[2], c_i, 0)
+            c_i[3], c_i[4], c_i[5] = 0.0, 0.0, 0.0
+        return
+    for r in range(6):
+        vJ[r] = 0.0
+    for k in range(iv, iv + n):
+        rotate6(R, dofs[k], S[k])
+        for r in range(6):
+            vJ[r] += S[k, r] * v[k]
+    for r in range(6):
+        vel_i[r] += vJ[r]
+    motion_cross(vel_i, vJ, c_i)
+
+
+@inline
 def finite_where(x, mask, value):
     """True when ``x[k]`` is finite for every ``k`` with ``mask[k] == value``."""
     for k in range(x.shape[0]):
         if mask[k] == value and not np.isfinite(x[k]):
             return False
     return True
+
+
+@inline
+def aligned_placement(i, par, liR, lip, oR, op, d):
+    """World placement ``oR[i], op[i]`` of body ``i`` from its local one, and ``d[i]``, the
+    vector from the origin of its parent ``par`` (``-1``: the world) to its own, in world axes."""
+    if par < 0:
+        for r in range(3):
+            d[i, r] = lip[i, r]
+            op[i, r] = lip[i, r]
+            for cc in range(3):
+                oR[i, r, cc] = liR[i, r, cc]
+        return
+    Rp = oR[par]
+    for r in range(3):
+        d[i, r] = Rp[r, 0] * lip[i, 0] + Rp[r, 1] * lip[i, 1] + Rp[r, 2] * lip[i, 2]
+        op[i, r] = op[par, r] + d[i, r]
+        for cc in range(3):
+            oR[i, r, cc] = Rp[r, 0] * liR[i, 0, cc] + Rp[r, 1] * liR[i, 1, cc] + Rp[r, 2] * liR[i, 2, cc]
 
 
 @inline
@@ -215,10 +276,11 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular. Inlined
     into :func:`hybrid_one` (one state) and :func:`aba_range` (a batch loop).
 
-    Spatial quantities are in body coordinates (RBDA Table 7.1), where the articulated
-    inertias keep the size of the bodies whatever their distance from the world origin."""
-    (_, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U, Dinv, u, UD, G, B3, PB, Ia, t1, t2,
-     _, _) = ws
+    Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
+    module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
+    ``d[i]`` the shift from the parent's origin."""
+    (_, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2,
+     _, _, theta) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
             and tau_known.shape[0] == nv and known.shape[0] == nv):
@@ -233,30 +295,22 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
             return BAD_QUATERNION
-        if fcode > 0:
-            world_placement(i, par, liR, lip, oR, op)
+        aligned_placement(i, par, liR, lip, oR, op, d)
         if par >= 0:
-            motion_act_inv(liR[i], lip[i], vel[par], vel[i])
+            shift_motion(d[i], vel[par], vel[i])
         else:
             vel[i, :] = 0.0
-        for r in range(6):
-            t1[r] = 0.0
-        for k in range(iv, iv + n):
-            for r in range(6):
-                t1[r] += dofs[k, r] * v[k]
-        for r in range(6):
-            vel[i, r] += t1[r]
-        motion_cross(vel[i], t1, c[i])
+        joint_motion(i, iv, n, ints[i, 5], oR[i], dofs, v, S, t1, vel[i], c[i])
         if known[iv]:
             for k in range(iv, iv + n):
                 for r in range(6):
-                    c[i, r] += dofs[k, r] * qdd_known[k]
-        theta = body[i, 15:25]
+                    c[i, r] += S[k, r] * qdd_known[k]
+        inertia_rotate(oR[i], body[i, 15:25], theta)
         inertia_matrix(theta, IA[i])
         inertia_mul(theta, vel[i], t1)
         force_cross(vel[i], t1, pA[i])
         if fcode >= 0:
-            wrench_to_local(fcode, oR[i], op[i], fext[i], t1)
+            wrench_to_aligned(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
                 pA[i, r] -= t1[r]
     # Pass 2: articulated inertias, the joints of known acceleration held rigid; each body
@@ -270,17 +324,25 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 for cc in range(6):
                     Ia[r, cc] = IA[i, r, cc]
         elif n == 1:
-            if not articulate_single_dof(IA[i], dofs[iv], dofs[iv, 6], c[i], pA[i],
-                                         tau_known[iv] - friction_torque(dofs, eps, v, iv),
-                                         iv, U[iv], Dinv, u, t1, Ia, t2):
+            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, v, iv), ints[i, 5]
+            if axis >= 3:
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
+                                           Ia, t2, 3, 6)
+            elif axis >= 0:
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
+                                           Ia, t2, 0, 3)
+            else:
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
+                                           Ia, t2, 0, 6)
+            if not ok:
                 return i + 1
         else:
             for k in range(iv, iv + n):
                 s = 0.0
                 for r in range(6):
-                    s += dofs[k, r] * pA[i, r]
+                    s += S[k, r] * pA[i, r]
                 u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
-            if not joint_inertia(IA[i], dofs, dofs, iv, n, U, Dinv, G):
+            if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
                 return i + 1
             if par < 0:
                 continue
@@ -292,17 +354,19 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                     s += UD[r, j] * u[iv + j]
                 t2[r] = s
         if par >= 0:
-            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
-            force_act(liR[i], lip[i], t2, t1)
+            congruence_shift(d[i], Ia, IA[par])
+            unshift_force(d[i], t2, t1)
             for r in range(6):
                 pA[par, r] += t1[r]
-    # Pass 3: accelerations of the joints of unknown acceleration, forces of the others
-    for k in range(6):
-        t2[k] = 0.0
-    t2[0], t2[1], t2[2] = -params[0], -params[1], -params[2]
+    # Pass 3: accelerations of the joints of unknown acceleration, forces of the others;
+    # a_0 = -g needs no shift to a root's origin (its angular part is zero)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        motion_act_inv(liR[i], lip[i], acc[par] if par >= 0 else t2, acc[i])
+        if par >= 0:
+            shift_motion(d[i], acc[par], acc[i])
+        else:
+            acc[i, 0], acc[i, 1], acc[i, 2] = -params[0], -params[1], -params[2]
+            acc[i, 3], acc[i, 4], acc[i, 5] = 0.0, 0.0, 0.0
         for r in range(6):
             acc[i, r] += c[i, r]
         if known[iv]:
@@ -313,7 +377,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 qdd[k] = qdd_known[k]
                 s = 0.0
                 for r in range(6):
-                    s += dofs[k, r] * t1[r]
+                    s += S[k, r] * t1[r]
                 tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
             continue
         if n == 1:
@@ -322,9 +386,9 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 s += U[iv, r] * acc[i, r]
             qdd[iv] = Dinv[iv, 0] * (u[iv] - s)
             for r in range(6):
-                acc[i, r] += dofs[iv, r] * qdd[iv]
+                acc[i, r] += S[iv, r] * qdd[iv]
         else:
-            joint_acceleration(dofs, U, Dinv, u, iv, n, acc[i], qdd, t1)
+            joint_acceleration(S, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):
             tau[k] = tau_known[k]
     return result_status(check, finite(qdd) and finite(tau))
