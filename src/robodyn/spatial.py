@@ -208,26 +208,32 @@ def force_cross(m, f, out):
 
 
 @inline
-def inertia_mul(theta, m, out):
-    """Momentum of a motion: ``out = I m`` with ``I`` given by its 10 parameters.
-
+def momentum(theta, m):
+    """Momentum of a motion, ``I m``, as a tuple ``(f0, f1, f2, n0, n1, n2)``, with ``I``
+    given by its 10 parameters (an array or a tuple):
     ``[f; n] = [mass v - h x w; I_o w + h x v]``.
     """
     mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
     ixx, ixy, iyy, ixz, iyz, izz = theta[4], theta[5], theta[6], theta[7], theta[8], theta[9]
     v0, v1, v2, w0, w1, w2 = m[0], m[1], m[2], m[3], m[4], m[5]
-    out[0] = mass * v0 - (hy * w2 - hz * w1)
-    out[1] = mass * v1 - (hz * w0 - hx * w2)
-    out[2] = mass * v2 - (hx * w1 - hy * w0)
-    out[3] = ixx * w0 + ixy * w1 + ixz * w2 + (hy * v2 - hz * v1)
-    out[4] = ixy * w0 + iyy * w1 + iyz * w2 + (hz * v0 - hx * v2)
-    out[5] = ixz * w0 + iyz * w1 + izz * w2 + (hx * v1 - hy * v0)
+    return (mass * v0 - (hy * w2 - hz * w1),
+            mass * v1 - (hz * w0 - hx * w2),
+            mass * v2 - (hx * w1 - hy * w0),
+            ixx * w0 + ixy * w1 + ixz * w2 + (hy * v2 - hz * v1),
+            ixy * w0 + iyy * w1 + iyz * w2 + (hz * v0 - hx * v2),
+            ixz * w0 + iyz * w1 + izz * w2 + (hx * v1 - hy * v0))
 
 
 @inline
-def inertia_rotate(R, theta, out):
-    """Inertial parameters of a body turned by the rotation ``R`` about the frame origin:
-    ``h' = R h``, ``I' = R I R^T``."""
+def inertia_mul(theta, m, out):
+    """``out = I m`` (see :func:`momentum`)."""
+    out[0], out[1], out[2], out[3], out[4], out[5] = momentum(theta, m)
+
+
+@inline
+def inertia_rotated(R, theta):
+    """Inertial parameters of a body turned by the rotation ``R`` about the frame origin,
+    as a tuple of 10: ``h' = R h``, ``I' = R I R^T``."""
     mass = theta[0]
     h0, h1, h2 = theta[1], theta[2], theta[3]
     ixx, ixy, iyy, ixz, iyz, izz = theta[4], theta[5], theta[6], theta[7], theta[8], theta[9]
@@ -241,16 +247,16 @@ def inertia_rotate(R, theta, out):
     a20 = ixz * R[0, 0] + iyz * R[0, 1] + izz * R[0, 2]
     a21 = ixz * R[1, 0] + iyz * R[1, 1] + izz * R[1, 2]
     a22 = ixz * R[2, 0] + iyz * R[2, 1] + izz * R[2, 2]
-    out[0] = mass
-    out[1] = R[0, 0] * h0 + R[0, 1] * h1 + R[0, 2] * h2
-    out[2] = R[1, 0] * h0 + R[1, 1] * h1 + R[1, 2] * h2
-    out[3] = R[2, 0] * h0 + R[2, 1] * h1 + R[2, 2] * h2
-    out[4] = R[0, 0] * a00 + R[0, 1] * a10 + R[0, 2] * a20
-    out[5] = R[0, 0] * a01 + R[0, 1] * a11 + R[0, 2] * a21
-    out[6] = R[1, 0] * a01 + R[1, 1] * a11 + R[1, 2] * a21
-    out[7] = R[0, 0] * a02 + R[0, 1] * a12 + R[0, 2] * a22
-    out[8] = R[1, 0] * a02 + R[1, 1] * a12 + R[1, 2] * a22
-    out[9] = R[2, 0] * a02 + R[2, 1] * a12 + R[2, 2] * a22
+    return (mass,
+            R[0, 0] * h0 + R[0, 1] * h1 + R[0, 2] * h2,
+            R[1, 0] * h0 + R[1, 1] * h1 + R[1, 2] * h2,
+            R[2, 0] * h0 + R[2, 1] * h1 + R[2, 2] * h2,
+            R[0, 0] * a00 + R[0, 1] * a10 + R[0, 2] * a20,
+            R[0, 0] * a01 + R[0, 1] * a11 + R[0, 2] * a21,
+            R[1, 0] * a01 + R[1, 1] * a11 + R[1, 2] * a21,
+            R[0, 0] * a02 + R[0, 1] * a12 + R[0, 2] * a22,
+            R[1, 0] * a02 + R[1, 1] * a12 + R[1, 2] * a22,
+            R[2, 0] * a02 + R[2, 1] * a12 + R[2, 2] * a22)
 
 
 @inline
@@ -261,25 +267,26 @@ def inertia_act(R, p, theta, out):
     ``I' = R I R^T - p h_r^T - h_r p^T + 2 (p . h_r) 1 - m p p^T + m |p|^2 1`` with
     ``h_r = R h`` (parallel-axis theorem without dividing by the mass).
     """
-    inertia_rotate(R, theta, out)
-    mass, hr0, hr1, hr2 = out[0], out[1], out[2], out[3]
+    mass, hr0, hr1, hr2, j00, j01, j11, j02, j12, j22 = inertia_rotated(R, theta)
     p0, p1, p2 = p[0], p[1], p[2]
     ph = p0 * hr0 + p1 * hr1 + p2 * hr2
     pp = p0 * p0 + p1 * p1 + p2 * p2
+    out[0] = mass
     out[1] = hr0 + mass * p0
     out[2] = hr1 + mass * p1
     out[3] = hr2 + mass * p2
-    out[4] += -2.0 * p0 * hr0 + 2.0 * ph - mass * p0 * p0 + mass * pp
-    out[5] += -p0 * hr1 - hr0 * p1 - mass * p0 * p1
-    out[6] += -2.0 * p1 * hr1 + 2.0 * ph - mass * p1 * p1 + mass * pp
-    out[7] += -p0 * hr2 - hr0 * p2 - mass * p0 * p2
-    out[8] += -p1 * hr2 - hr1 * p2 - mass * p1 * p2
-    out[9] += -2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
+    out[4] = j00 - 2.0 * p0 * hr0 + 2.0 * ph - mass * p0 * p0 + mass * pp
+    out[5] = j01 - p0 * hr1 - hr0 * p1 - mass * p0 * p1
+    out[6] = j11 - 2.0 * p1 * hr1 + 2.0 * ph - mass * p1 * p1 + mass * pp
+    out[7] = j02 - p0 * hr2 - hr0 * p2 - mass * p0 * p2
+    out[8] = j12 - p1 * hr2 - hr1 * p2 - mass * p1 * p2
+    out[9] = j22 - 2.0 * p2 * hr2 + 2.0 * ph - mass * p2 * p2 + mass * pp
 
 
 @inline
 def inertia_matrix(theta, out):
-    """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters."""
+    """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters (an
+    array or a tuple)."""
     mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
     # rows 0-2: [m 1, -[h]x]; rows 3-5: [[h]x, I_o]
     out[0, 0], out[0, 1], out[0, 2], out[0, 3], out[0, 4], out[0, 5] = mass, 0.0, 0.0, 0.0, hz, -hy

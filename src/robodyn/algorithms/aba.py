@@ -36,7 +36,8 @@ from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
-from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_mul, inertia_rotate, matvec6,
+from ..joints import FREE
+from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, momentum,
                        motion_cross, rotate6, shift_motion, unshift_force, wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -49,9 +50,9 @@ SINGULAR_RTOL = 1e-12
 @kernel
 def workspace(nb, nv):
     """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
-    Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known, theta)``; ``tau`` receives :func:`aba_one`'s
-    copy of the joint forces and ``known`` is all False (no joint of known acceleration)."""
-    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 166)
+    Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
+    of the joint forces and ``known`` is all False (no joint of known acceleration)."""
+    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
     P, o = poses(buf, 0, nb)
     vel, o = take(buf, o, (nb, 6))
     c, o = take(buf, o, (nb, 6))
@@ -69,8 +70,7 @@ def workspace(nb, nv):
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    theta, o = take(buf, o, (10,))
-    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_), theta
+    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
 
 
 @inline
@@ -105,6 +105,50 @@ def invert_block(Dinv, iv, n, G, tol):
     for r in range(n):
         for c in range(n):
             Dinv[iv + r, c] = G[r, n + c]
+    return True
+
+
+@inline
+def solve_block(A, y, n, G, x, tol):
+    """``x = A^-1 y`` for the n x n block ``A[:n, :n]`` (Gaussian elimination with partial
+    pivoting on ``G[:n, :n + 1]``). Returns False when a pivot is not above ``tol``."""
+    for r in range(n):
+        for cc in range(n):
+            G[r, cc] = A[r, cc]
+        G[r, n] = y[r]
+    for col in range(n):
+        piv, best = col, abs(G[col, col])
+        for r in range(col + 1, n):
+            if abs(G[r, col]) > best:
+                piv, best = r, abs(G[r, col])
+        if best <= tol:  # (NaN input with check_finite=False propagates instead)
+            return False
+        if piv != col:
+            for cc in range(col, n + 1):
+                G[col, cc], G[piv, cc] = G[piv, cc], G[col, cc]
+        inv = 1.0 / G[col, col]
+        for r in range(col + 1, n):
+            fac = G[r, col] * inv
+            for cc in range(col + 1, n + 1):
+                G[r, cc] -= fac * G[col, cc]
+    for r in range(n - 1, -1, -1):
+        s = G[r, n]
+        for cc in range(r + 1, n):
+            s -= G[r, cc] * x[cc]
+        x[r] = s / G[r, r]
+    return True
+
+
+@inline
+def free_root(ints, dofs, i):
+    """True when body ``i`` is a root on a free joint without armature: its joint's
+    ``D = S^T IA S`` needs no inverse (see :func:`hybrid_state`, pass 3)."""
+    if ints[i, 0] >= 0 or ints[i, 1] != FREE:
+        return False
+    iv = ints[i, 3]
+    for k in range(iv, iv + 6):
+        if dofs[k, 6] != 0.0:
+            return False
     return True
 
 
@@ -280,7 +324,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
     ``d[i]`` the shift from the parent's origin."""
     (_, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2,
-     _, _, theta) = ws
+     _, _) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
             and tau_known.shape[0] == nv and known.shape[0] == nv):
@@ -305,10 +349,9 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
             for k in range(iv, iv + n):
                 for r in range(6):
                     c[i, r] += S[k, r] * qdd_known[k]
-        inertia_rotate(oR[i], body[i, 15:25], theta)
+        theta = inertia_rotated(oR[i], body[i, 15:25])
+        force_cross(vel[i], momentum(theta, vel[i]), pA[i])
         inertia_matrix(theta, IA[i])
-        inertia_mul(theta, vel[i], t1)
-        force_cross(vel[i], t1, pA[i])
         if fcode >= 0:
             wrench_to_aligned(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
@@ -342,6 +385,8 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 for r in range(6):
                     s += S[k, r] * pA[i, r]
                 u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
+            if free_root(ints, dofs, i):
+                continue  # solved in pass 3
             if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
                 return i + 1
             if par < 0:
@@ -387,6 +432,22 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
             qdd[iv] = Dinv[iv, 0] * (u[iv] - s)
             for r in range(6):
                 acc[i, r] += S[iv, r] * qdd[iv]
+        elif free_root(ints, dofs, i):
+            # S = diag(R, R) is orthogonal, so with D = S^T IA S and U = IA S:
+            # qdd = D^-1 (u - U^T a) = S^T (IA^-1 S u - a), and a + S qdd = IA^-1 S u
+            rotate6(oR[i], u[iv:iv + 6], t1)
+            scale = 0.0
+            for r in range(6):
+                scale += abs(IA[i, r, r])
+            if not solve_block(IA[i], t1, 6, G, t2, SINGULAR_RTOL * scale):
+                return i + 1
+            for r in range(6):
+                t1[r] = t2[r] - acc[i, r]
+                acc[i, r] = t2[r]
+            R = oR[i]
+            for r in range(3):
+                qdd[iv + r] = R[0, r] * t1[0] + R[1, r] * t1[1] + R[2, r] * t1[2]
+                qdd[iv + 3 + r] = R[0, r] * t1[3] + R[1, r] * t1[4] + R[2, r] * t1[5]
         else:
             joint_acceleration(S, U, Dinv, u, iv, n, acc[i], qdd, t1)
         for k in range(iv, iv + n):

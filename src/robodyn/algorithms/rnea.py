@@ -21,7 +21,7 @@ from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
-from ..spatial import (force_act, force_cross, inertia_mul, motion_act_inv, motion_cross, motion_cross_unit,
+from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -127,8 +127,7 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
         motion_step(i, par, dofs, ints[i, 3], ints[i, 4], ints[i, 5], liR[i], lip[i], v, a, vel, acc, t2, vJ, t1)
         theta = body[i, 15:25]
         inertia_mul(theta, acc[i], f[i])
-        inertia_mul(theta, vel[i], t1)
-        force_cross(vel[i], t1, vJ)
+        force_cross(vel[i], momentum(theta, vel[i]), vJ)
         for r in range(6):
             f[i, r] += vJ[r]
         if fcode >= 0:
