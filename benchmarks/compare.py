@@ -27,7 +27,9 @@ import numba
 import numpy as np
 
 import robodyn as rd
-from robodyn.bench import Timing, batch_timings, format_table, paired_us, per_call_us, single_call_timings
+from robodyn.bench import Timing, agreement, batch_timings, format_table, paired_us, per_call_us, single_call_timings
+
+TOL = 1e-9  # the core dynamics' tolerance against Pinocchio
 
 HERE = Path(__file__).resolve().parent
 
@@ -51,8 +53,14 @@ def pinocchio_section(name: str, relpath: str, floating: bool, batch: int) -> st
         raise SystemExit(f"{name}: continuous joints make the q layouts differ; pick another robot")
     single = single_call_timings(model, pm)
     batched = batch_timings(model, batch, pm)
+    errors = agreement(model, pm, batch)
+    bad = {k: e for k, e in errors.items() if not e <= TOL}
+    if bad:
+        raise SystemExit(f"{name}: robodyn and Pinocchio differ beyond {TOL:g} on benchmarked states: {bad}")
     head = f"### {name} ({'floating' if floating else 'fixed'} base, nv = {model.nv}) vs Pinocchio {pin.__version__}\n"
-    return head + "\n```\n" + format_table(single + batched) + "\n```\n"
+    agree = ", ".join(f"{k} {e:.1e}" for k, e in errors.items())
+    return (head + "\n```\n" + format_table(single + batched) + "\n```\n\n"
+            + f"Largest relative error against Pinocchio over the benchmarked states: {agree}.\n")
 
 
 def rtb_section(batch: int) -> str:

@@ -97,6 +97,26 @@ def test_to_pinocchio_matches(capsys):
         np.testing.assert_allclose(pin.rnea(pm, pm.createData(), q, v, a), rd.rnea(model, q, v, a), rtol=1e-10, atol=1e-10)
 
 
+def test_benchmark_agreement_check_sees_a_difference():
+    """``bench.agreement`` (what ``benchmarks/compare.py`` checks before it reports) is tiny on
+    the same robot and large when the Pinocchio model differs by one mass."""
+    import pinocchio as pin
+
+    from robodyn.bench import agreement, to_pinocchio
+    from robodyn.random import random_model
+
+    # a chain: Pinocchio's CRBA needs the bodies in depth-first order, which a random tree lacks
+    model = random_model(6, seed=5, floating_base=True, branching=0.0)
+    errors = agreement(model, to_pinocchio(model), 40)
+    assert set(errors) == {"rnea", "aba", "crba", "coriolis_matrix"} and max(errors.values()) < 1e-11
+    pm = to_pinocchio(model)
+    I = pm.inertias[3]
+    pm.inertias[3] = pin.Inertia(2 * I.mass + 1, I.lever, I.inertia)
+    assert min(agreement(model, pm, 40).values()) > 1e-6
+    with pytest.raises(ValueError, match="depth-first"):  # parents [-1, 0, 0, 0, 3, 1, 5]
+        to_pinocchio(random_model(6, seed=5, floating_base=True))
+
+
 @pytest.mark.parametrize("argv, message", [
     (("info", "no_such_robot"), "unknown model 'no_such_robot'"),
     (("demo", "/nonexistent/robot.urdf"), "cannot read"),

@@ -25,8 +25,19 @@ def to_pinocchio(model):
 
     Revolute and prismatic joints on a coordinate axis become Pinocchio's RX/RY/RZ/PX/PY/PZ
     joints, others its unaligned variants; a free joint becomes a free flyer.
+
+    Pinocchio's subtree algorithms (its CRBA) need the bodies in depth-first order; a model
+    in another order (a random tree, say) raises ``ValueError``.
     """
     import pinocchio as pin
+
+    for i in range(1, model.nbodies):  # depth-first: the parent of i is i - 1 or one of its ancestors
+        j = i - 1
+        while j >= 0 and j != model.parent[i]:
+            j = model.parent[j]
+        if j != model.parent[i]:
+            raise ValueError(f"to_pinocchio: body {i} ({model.link_names[i]!r}) breaks the depth-first order "
+                             "Pinocchio needs (its parent is not body i - 1 or one of its ancestors)")
 
     pm = pin.Model()
     pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float), np.zeros(3))
@@ -178,6 +189,42 @@ def batch_timings(model, batch: int, pm=None, seed: int = 0) -> list[Timing]:
         loop = name in ("crba (batch)", "coriolis_matrix (batch)")  # Pinocchio: a Python loop of n_loop calls
         out.append(Timing(name, ours / batch, None if theirs is None else theirs / (n_loop if loop else batch)))
     return out
+
+
+def rel_error(actual, expected) -> float:
+    """``max |actual - expected| / max(1, max |expected|)`` (the tests' relative error)."""
+    return float(np.max(np.abs(actual - expected)) / max(1.0, np.max(np.abs(expected))))
+
+
+def agreement(model, pm, batch: int, seed: int = 0) -> dict:
+    """Largest relative error (see :func:`rel_error`, state by state) between robodyn and
+    Pinocchio on the states :func:`batch_timings` times: every state for ``rnea`` and ``aba``
+    (Pinocchio's parallel calls), the looped states for ``crba`` and ``coriolis_matrix``.
+    Joint friction, which Pinocchio's dynamics leave out, is switched off here."""
+    import pinocchio as pin
+
+    import robodyn as rd
+
+    _, (Q, V, A) = states(model, batch, seed)
+    threads = numba.get_num_threads()
+    pool = pin.ModelPool(pm, threads)
+    Qt, Vt, At = (np.asfortranarray(X.T) for X in (Q, V, A))
+    out = np.zeros((model.nv, batch), order="F")
+    pd = pm.createData()
+    n_loop = min(batch, 2000)
+    errors = {}
+    pin.rneaInParallel(threads, pool, Qt, Vt, At, out)
+    errors["rnea"] = max(map(rel_error, rd.rnea(model, Q, V, A, friction=False), out.T))
+    pin.abaInParallel(threads, pool, Qt, Vt, At, out)
+    errors["aba"] = max(map(rel_error, rd.aba(model, Q, V, A, friction=False), out.T))
+    M, C = rd.crba(model, Q[:n_loop]), rd.coriolis_matrix(model, Q[:n_loop], V[:n_loop])
+    errors["crba"] = errors["coriolis_matrix"] = 0.0
+    for s in range(n_loop):
+        Mp = pin.crba(pm, pd, Q[s])  # upper triangle
+        errors["crba"] = max(errors["crba"], rel_error(M[s], np.triu(Mp) + np.triu(Mp, 1).T))
+        errors["coriolis_matrix"] = max(errors["coriolis_matrix"],
+                                        rel_error(C[s], pin.computeCoriolisMatrix(pm, pd, Q[s], V[s])))
+    return errors
 
 
 def format_table(rows: list[Timing], other: str = "pinocchio") -> str:
