@@ -185,7 +185,7 @@ def batch_timings(model, batch: int, pm=None, seed: int = 0) -> list[Timing]:
         }
     out = []
     for name, fn in calls.items():
-        ours, theirs = paired_us(fn, others.get(name), rounds=5)
+        ours, theirs = paired_us(fn, others.get(name), rounds=9)
         loop = name in ("crba (batch)", "coriolis_matrix (batch)")  # Pinocchio: a Python loop of n_loop calls
         out.append(Timing(name, ours / batch, None if theirs is None else theirs / (n_loop if loop else batch)))
     return out

@@ -15,7 +15,7 @@ from numba import prange
 
 from .._jit import inline, kernel, parallel
 from ..joint_kernels import body_placement
-from ..spatial import compose, motion_act
+from ..spatial import compose, cross_into, motion_act
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
 
@@ -54,10 +54,23 @@ def world_placements(ints, liR, lip, oR, op):
 
 @inline
 def world_motion_subspace(ints, dofs, oR, op, oS):
-    """``oS[k]``: motion subspace column ``k`` in world coordinates (``J`` of its body)."""
+    """``oS[k]``: motion subspace column ``k`` in world coordinates (``J`` of its body). A
+    joint along a body axis (``S = e_r``, ``ints[i, 5] = r``) takes column ``r`` of the
+    rotation: ``[R e_r; 0]`` for a translation, ``[p x R e_r; R e_r]`` for a rotation."""
     for i in range(ints.shape[0]):
-        for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
-            motion_act(oR[i], op[i], dofs[k, :6], oS[k])
+        axis = ints[i, 5]
+        if axis >= 3:
+            R, p, k, c = oR[i], op[i], ints[i, 3], axis - 3
+            w0, w1, w2 = R[0, c], R[1, c], R[2, c]
+            cross_into(p[0], p[1], p[2], w0, w1, w2, oS[k], 0)
+            oS[k, 3], oS[k, 4], oS[k, 5] = w0, w1, w2
+        elif axis >= 0:
+            R, k = oR[i], ints[i, 3]
+            oS[k, 0], oS[k, 1], oS[k, 2] = R[0, axis], R[1, axis], R[2, axis]
+            oS[k, 3], oS[k, 4], oS[k, 5] = 0.0, 0.0, 0.0
+        else:
+            for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
+                motion_act(oR[i], op[i], dofs[k, :6], oS[k])
 
 
 @inline
