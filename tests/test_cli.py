@@ -117,6 +117,16 @@ def test_benchmark_agreement_check_sees_a_difference():
         to_pinocchio(random_model(6, seed=5, floating_base=True))
 
 
+def test_bench_of_a_tree_pinocchio_cannot_order_times_robodyn_alone(capsys):
+    from robodyn.bench import run_bench
+    from robodyn.random import random_model
+
+    assert run_bench(random_model(6, seed=5, floating_base=True), "tree", batch=10) == 0
+    out = capsys.readouterr().out
+    assert "robodyn timings only: to_pinocchio: body 5" in out
+    assert re.search(r"^\s+aba \(batch\)\s+\d+\.\d+\s*$", out, re.M)  # no Pinocchio column
+
+
 @pytest.mark.parametrize("argv, message", [
     (("info", "no_such_robot"), "unknown model 'no_such_robot'"),
     (("demo", "/nonexistent/robot.urdf"), "cannot read"),

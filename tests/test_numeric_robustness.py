@@ -115,7 +115,9 @@ def _pin_talos_like():
     """A floating-base random tree with mixed masses, converted to Pinocchio."""
     from robodyn.bench import to_pinocchio
 
-    tree = random_model(9, seed=3, floating_base=True, branching=0.6)
+    # parents [-1, 0, 0, 2, 3, 4, 2, 6, 7, 6]: three branch points, in the depth-first order
+    # a Pinocchio model needs (``to_pinocchio`` refuses other orders)
+    tree = random_model(9, seed=8, floating_base=True, branching=0.6)
     rng = np.random.default_rng(8)
     model = _scaled(tree, 10.0 ** rng.uniform(-3, 3, tree.nbodies))
     return model, to_pinocchio(model)

@@ -244,6 +244,8 @@ def run_bench(model, label: str, batch: int = 10000, compare: bool = True) -> in
             pm = to_pinocchio(model)
         except ImportError:
             print("(Pinocchio is not installed: robodyn timings only; `pip install pin` to compare)")
+        except ValueError as e:  # a tree Pinocchio cannot represent in robodyn's body order
+            print(f"(robodyn timings only: {e})")
     print(f"robodyn bench on {label!r}: nq={model.nq}, nv={model.nv}, {model.nbodies} bodies, "
           f"{numba.get_num_threads()} threads")
     print("Single calls from Python (input checks on), microseconds per call:")
