@@ -20,6 +20,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import robodyn as rd
+from robodyn import bench
 from robodyn import joints as J
 from robodyn.random import random_model, random_state
 
@@ -62,9 +63,7 @@ def rel_error(actual, expected) -> float:
     """``max |actual - expected| / max(1, max |expected|)``."""
     actual, expected = np.asarray(actual, dtype=float), np.asarray(expected, dtype=float)
     assert actual.shape == expected.shape, f"shape {actual.shape} != expected {expected.shape}"
-    if expected.size == 0:
-        return 0.0
-    return float(np.max(np.abs(actual - expected)) / max(1.0, np.max(np.abs(expected))))
+    return bench.rel_error(actual, expected)
 
 
 def assert_rel(actual, expected, tol: float = 1e-9, what: str = "") -> None:

@@ -34,39 +34,26 @@ def random_symmetric6():
     return A + A.T
 
 
-@njit
-def _congruence_shift(d, A):
-    out = np.zeros((6, 6))
-    sp.congruence_shift(d, A, out)
-    return out
+def into(helper, shape, nargs=2):
+    """A compiled ``f(x, y[, z])`` returning ``helper(x, y[, z], out)``'s output ``out``."""
+    if nargs == 2:
+        @njit
+        def call(x, y):
+            out = np.zeros(shape)
+            helper(x, y, out)
+            return out
+    else:
+        @njit
+        def call(x, y, z):
+            out = np.zeros(shape)
+            helper(x, y, z, out)
+            return out
+    return call
 
 
-@njit
-def _congruence_to_parent(R, p, A):
-    out = np.zeros((6, 6))
-    sp.congruence_to_parent(R, p, A, np.empty((3, 3, 3)), np.empty((3, 3)), out)
-    return out
-
-
-@njit
-def _shift_motion(d, m):
-    out = np.empty(6)
-    sp.shift_motion(d, m, out)
-    return out
-
-
-@njit
-def _unshift_force(d, f):
-    out = np.empty(6)
-    sp.unshift_force(d, f, out)
-    return out
-
-
-@njit
-def _inertia_act(R, p, theta):
-    out = np.empty(10)
-    sp.inertia_act(R, p, theta, out)
-    return out
+_congruence_shift = into(sp.congruence_shift, (6, 6))
+_shift_motion, _unshift_force, _rotate6 = (into(h, 6) for h in (sp.shift_motion, sp.unshift_force, sp.rotate6))
+_inertia_act = into(sp.inertia_act, 10, nargs=3)
 
 
 @njit
@@ -77,9 +64,9 @@ def _inertia_matrix(theta):
 
 
 @njit
-def _rotate6(R, x):
-    out = np.empty(6)
-    sp.rotate6(R, x, out)
+def _congruence_to_parent(R, p, A):
+    out = np.zeros((6, 6))
+    sp.congruence_to_parent(R, p, A, np.empty((3, 3, 3)), np.empty((3, 3)), out)
     return out
 
 

@@ -74,6 +74,23 @@ def workspace(nb, nv):
 
 
 @inline
+def pivot(G, col, n, lo, hi, tol):
+    """Partial pivoting of column ``col`` of ``G[:n]``: swap in (columns ``lo..hi``) the row
+    below ``col`` of largest magnitude. Returns False when that magnitude is not above
+    ``tol`` (NaN input with check_finite=False propagates instead)."""
+    piv, best = col, abs(G[col, col])
+    for r in range(col + 1, n):
+        if abs(G[r, col]) > best:
+            piv, best = r, abs(G[r, col])
+    if best <= tol:
+        return False
+    if piv != col:
+        for c in range(lo, hi):
+            G[col, c], G[piv, c] = G[piv, c], G[col, c]
+    return True
+
+
+@inline
 def invert_block(Dinv, iv, n, G, tol):
     """Invert the n x n block ``Dinv[iv:iv+n, :n]`` in place (Gauss-Jordan, partial pivoting).
 
@@ -84,15 +101,8 @@ def invert_block(Dinv, iv, n, G, tol):
             G[r, c] = Dinv[iv + r, c]
             G[r, n + c] = 1.0 if r == c else 0.0
     for col in range(n):
-        piv, best = col, abs(G[col, col])
-        for r in range(col + 1, n):
-            if abs(G[r, col]) > best:
-                piv, best = r, abs(G[r, col])
-        if best <= tol:  # (NaN input with check_finite=False propagates instead)
+        if not pivot(G, col, n, 0, 2 * n, tol):
             return False
-        if piv != col:
-            for c in range(2 * n):
-                G[col, c], G[piv, c] = G[piv, c], G[col, c]
         inv = 1.0 / G[col, col]
         for c in range(2 * n):
             G[col, c] *= inv
@@ -117,15 +127,8 @@ def solve_block(A, y, n, G, x, tol):
             G[r, cc] = A[r, cc]
         G[r, n] = y[r]
     for col in range(n):
-        piv, best = col, abs(G[col, col])
-        for r in range(col + 1, n):
-            if abs(G[r, col]) > best:
-                piv, best = r, abs(G[r, col])
-        if best <= tol:  # (NaN input with check_finite=False propagates instead)
+        if not pivot(G, col, n, col, n + 1, tol):
             return False
-        if piv != col:
-            for cc in range(col, n + 1):
-                G[col, cc], G[piv, cc] = G[piv, cc], G[col, cc]
         inv = 1.0 / G[col, col]
         for r in range(col + 1, n):
             fac = G[r, col] * inv
@@ -153,14 +156,21 @@ def free_root(ints, dofs, i):
 
 
 @inline
+def inertia_scale(IA_i):
+    """``sum_r |IA_i[r, r]|``, the size a singular pivot is measured against."""
+    scale = 0.0
+    for r in range(6):
+        scale += abs(IA_i[r, r])
+    return scale
+
+
+@inline
 def joint_inertia(IA_i, S, dofs, iv, n, U, Dinv, G):
     """``U_k = IA_i S_k`` (rows ``iv..iv+n`` of ``U``) and ``D^-1 = (S^T IA_i S + armature)^-1``
     (rows ``iv..iv+n`` of ``Dinv``) for one joint, with ``S_k = S[k, :6]`` in the frame of
     ``IA_i`` and the armature in ``dofs[k, 6]``. Returns False when ``D`` is singular: a pivot
     below ``SINGULAR_RTOL`` times the scale of ``IA_i`` (NaN input propagates)."""
-    scale = 0.0
-    for r in range(6):
-        scale += abs(IA_i[r, r])
+    scale = inertia_scale(IA_i)
     for k in range(iv, iv + n):
         matvec6(IA_i, S[k, :6], U[k])
         for j in range(iv, iv + n):
@@ -222,7 +232,7 @@ def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u,
     motion); callers pass constants, so the loops unroll. ``t`` (6,) is scratch. Returns False
     when ``D`` is singular (see :func:`joint_inertia`)."""
     c0, c1, c2, c3, c4, c5 = c_i[0], c_i[1], c_i[2], c_i[3], c_i[4], c_i[5]
-    D, Uc, scale, Sp = armature, 0.0, 0.0, 0.0
+    D, Uc, Sp = armature, 0.0, 0.0
     for r in range(6):
         ur = 0.0
         for j in range(lo, hi):
@@ -230,11 +240,10 @@ def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u,
         U_k[r] = ur
         t[r] = IA_i[r, 0] * c0 + IA_i[r, 1] * c1 + IA_i[r, 2] * c2 + IA_i[r, 3] * c3 + IA_i[r, 4] * c4 + IA_i[r, 5] * c5
         Uc += ur * c_i[r]
-        scale += abs(IA_i[r, r])
     for j in range(lo, hi):
         D += S[j] * U_k[j]
         Sp += S[j] * pA_i[j]
-    if abs(D) <= SINGULAR_RTOL * scale:
+    if abs(D) <= SINGULAR_RTOL * inertia_scale(IA_i):
         return False
     dinv = 1.0 / D
     Dinv[iv, 0] = dinv
@@ -258,7 +267,8 @@ def joint_motion(i, iv, n, axis, R, dofs, v, S, vJ, vel_i, c_i):
     when the joint's ``S`` is the unit motion ``e_axis`` (see ``Model._pack``): then ``S``
     is a column of ``R`` in one half and zero in the other."""
     if axis >= 0:
-        lo, col, qd = (0, axis, v[iv]) if axis < 3 else (3, axis - 3, v[iv])
+        lo = 0 if axis < 3 else 3
+        col, qd = axis - lo, v[iv]
         for r in range(6):
             S[iv, r] = 0.0
             vJ[r] = 0.0
@@ -436,10 +446,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
             # S = diag(R, R) is orthogonal, so with D = S^T IA S and U = IA S:
             # qdd = D^-1 (u - U^T a) = S^T (IA^-1 S u - a), and a + S qdd = IA^-1 S u
             rotate6(oR[i], u[iv:iv + 6], t1)
-            scale = 0.0
-            for r in range(6):
-                scale += abs(IA[i, r, r])
-            if not solve_block(IA[i], t1, 6, G, t2, SINGULAR_RTOL * scale):
+            if not solve_block(IA[i], t1, 6, G, t2, SINGULAR_RTOL * inertia_scale(IA[i])):
                 return i + 1
             for r in range(6):
                 t1[r] = t2[r] - acc[i, r]
