@@ -1,6 +1,7 @@
 """The single-state fast paths of rnea, aba, crba and coriolis_matrix (compiled for contiguous
 float64 vectors only) and the general path they fall back to: every other kind of input gives
-the same result, and the workspaces carved from one buffer never overrun it."""
+the same result, results written into ``out`` equal the returned ones, and the workspaces
+carved from one buffer never overrun it."""
 
 from __future__ import annotations
 
@@ -70,6 +71,59 @@ def test_bad_sizes_and_values_still_raise_on_the_fast_path():
         rd.rnea(model, q, v, bad)
     with pytest.raises(ValueError, match=r"tau contains NaN"):
         rd.aba(model, q, v, bad)
+
+
+OUT_CALLS = {
+    "rnea": lambda m, q, v, a, **kw: rd.rnea(m, q, v, a, **kw),
+    "aba": lambda m, q, v, a, **kw: rd.aba(m, q, v, a, **kw),
+    "crba": lambda m, q, v, a, **kw: rd.crba(m, q, **kw),
+    "coriolis_matrix": lambda m, q, v, a, **kw: rd.coriolis_matrix(m, q, v, **kw),
+}
+
+
+@pytest.mark.parametrize("model", MODELS, ids=["panda", "floating tree"])
+@pytest.mark.parametrize("name", list(OUT_CALLS))
+@pytest.mark.parametrize("size", [(), (3,), (2, 2)], ids=["single", "batch", "2-D batch"])
+def test_out_receives_the_result_and_is_returned(model, name, size):
+    call = OUT_CALLS[name]
+    q, v, a = random_state(model, np.random.default_rng(4), size)
+    expected = call(model, q, v, a)
+    out = np.full(expected.shape, np.nan)
+    assert call(model, q, v, a, out=out) is out
+    assert_rel(out, expected, 0.0, f"{name} into out")
+    listed = call(model, q.tolist(), v.tolist(), a.tolist(), out=out)  # the general path
+    assert listed is out
+    assert_rel(out, expected, 0.0, f"{name} into out, list inputs")
+
+
+@pytest.mark.parametrize("name", list(OUT_CALLS))
+def test_unusable_out_is_refused_and_left_alone(name):
+    model = MODELS[0]
+    call = OUT_CALLS[name]
+    q, v, a = random_state(model, np.random.default_rng(5), (2,))
+    shape = call(model, q, v, a).shape
+    cases = {
+        r"out: expected shape": np.zeros(shape[:-1] + (shape[-1] + 1,)),
+        r"out: expected shape \(2, ": np.zeros(shape[1:]),  # a single result's shape for a batch
+        r"out: expected a float64 ndarray, got ndarray of float32": np.zeros(shape, dtype=np.float32),
+        r"out: expected a float64 ndarray, got list": np.zeros(shape).tolist(),
+        r"out: must be C-contiguous": np.zeros(shape[::-1]).T,
+    }
+    read_only = np.zeros(shape)
+    read_only.flags.writeable = False
+    cases[r"out: must be C-contiguous and writeable"] = read_only
+    for message, out in cases.items():
+        for state in ((q, v, a), (q[0], v[0], a[0])):  # batch and single state
+            if state[0].ndim == 1 and np.shape(out) == shape[1:]:
+                continue  # a single result's shape is right for a single state
+            with pytest.raises(ValueError, match=message if state[0].ndim == 2 else r"out: "):
+                call(model, *state, out=out)
+    if name in ("rnea", "aba"):  # the inputs and the output have the same shape: no aliasing
+        with pytest.raises(ValueError, match=r"out: shares memory with the input v"):
+            call(model, q, v, a, out=v)
+        with pytest.raises(ValueError, match=r"out: shares memory with the input"):
+            call(model, q[0], v[0], a[0], out=a[0])
+        np.testing.assert_equal(a, random_state(model, np.random.default_rng(5), (2,))[2])
 
 
 @numba.njit

@@ -132,15 +132,17 @@ def states(model, batch: int, seed: int = 0):
     return (Q[0].copy(), V[0].copy(), A[0].copy()), (Q, V, A)
 
 
-def robodyn_calls(model, q, v, a, suffix: str = "") -> dict:
-    """The four timed calls on the states ``(q, v, a)`` (single or batched), by name."""
+def robodyn_calls(model, q, v, a, suffix: str = "", out: bool = False) -> dict:
+    """The four timed calls on the states ``(q, v, a)`` (single or batched), by name; with
+    ``out``, each writes into an array allocated once (as Pinocchio's calls write into theirs)."""
     import robodyn as rd
 
+    vec, mat = ((np.empty(v.shape), np.empty(v.shape + (model.nv,))) if out else (None, None))
     return {
-        "rnea" + suffix: lambda: rd.rnea(model, q, v, a),
-        "aba" + suffix: lambda: rd.aba(model, q, v, a),
-        "crba" + suffix: lambda: rd.crba(model, q),
-        "coriolis_matrix" + suffix: lambda: rd.coriolis_matrix(model, q, v),
+        "rnea" + suffix: lambda: rd.rnea(model, q, v, a, out=vec),
+        "aba" + suffix: lambda: rd.aba(model, q, v, a, out=vec),
+        "crba" + suffix: lambda: rd.crba(model, q, out=mat),
+        "coriolis_matrix" + suffix: lambda: rd.coriolis_matrix(model, q, v, out=mat),
     }
 
 
@@ -164,10 +166,11 @@ def single_call_timings(model, pm=None, seed: int = 0) -> list[Timing]:
 
 def batch_timings(model, batch: int, pm=None, seed: int = 0) -> list[Timing]:
     """Per-state times of batched calls; Pinocchio's ``rneaInParallel``/``abaInParallel``
-    with the same number of threads, and Python loops over ``crba``/``computeCoriolisMatrix``."""
+    with the same number of threads, and Python loops over ``crba``/``computeCoriolisMatrix``.
+    Both libraries write into arrays allocated before the timing (robodyn's ``out=``)."""
     _, (Q, V, A) = states(model, batch, seed)
     threads = numba.get_num_threads()
-    calls = robodyn_calls(model, Q, V, A, " (batch)")
+    calls = robodyn_calls(model, Q, V, A, " (batch)", out=True)
     others = {}
     if pm is not None:
         import pinocchio as pin

@@ -30,6 +30,13 @@ BAD_QUATERNION = -2
 WRONG_SIZE = -3
 NONFINITE_RESULT = -4
 
+# Constant arguments of the compiled per-state functions, as NumPy scalars: a Python literal
+# (``-1``, ``True``) in a call from compiled code makes Numba compile a separate copy of the
+# callee for that constant (minutes for the ABA); these are typed int64/bool like the runtime
+# values of the other callers, which then share one compiled copy.
+NO_WRENCH = np.int64(-1)  # ``fcode`` without external wrenches
+CHECKED = np.bool_(True)  # ``check``: the NaN/Inf checks on
+
 
 @inline
 def nq_of(ints):
@@ -96,10 +103,12 @@ _F8 = np.dtype(np.float64)
 
 
 def vectors(*xs) -> bool:
-    """True when every argument is a 1-D float64 ndarray: the single-state fast path, where the
-    kernel itself checks the sizes (status ``WRONG_SIZE``) and values."""
+    """True when every argument is a writeable C-contiguous 1-D float64 ndarray: the
+    single-state fast path, where the kernel itself checks the sizes (status ``WRONG_SIZE``)
+    and values. (The one array type the kernels are compiled for: see :func:`states`.)"""
     for x in xs:
-        if not (type(x) is np.ndarray and x.ndim == 1 and x.dtype is _F8):
+        if not (type(x) is np.ndarray and x.ndim == 1 and x.dtype is _F8 and x.flags.c_contiguous
+                and x.flags.writeable):
             return False
     return True
 
@@ -181,9 +190,48 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
         if full != batch:
             raise ValueError(f"f_ext: batch shape {f.shape[:-2]} does not match the states' {batch}")
         f = np.broadcast_to(f, batch + (nb, 6))
-    if batch == ():
-        return np.ascontiguousarray(f), codes[frame]
-    return np.ascontiguousarray(f.reshape(-1, nb, 6)), codes[frame]
+    f = np.ascontiguousarray(f if batch == () else f.reshape(-1, nb, 6)).view()
+    f.flags.writeable = False  # read-only as the model's zero wrenches: one compiled specialisation
+    return f, codes[frame]
+
+
+def fast_out(out, shape: tuple, *inputs):
+    """The output array of a single-state fast path: a new ``np.empty(shape)`` when ``out`` is
+    None, ``out`` itself when it is a writeable C-contiguous float64 array of exactly ``shape``
+    that shares no memory with the ``inputs``, else None (the caller then takes its general
+    path, where :func:`output` says what is wrong)."""
+    if out is None:
+        return np.empty(shape)
+    if (type(out) is np.ndarray and out.dtype is _F8 and out.shape == shape and out.flags.c_contiguous
+            and out.flags.writeable and not any(np.may_share_memory(out, x) for x in inputs)):
+        return out
+    return None
+
+
+def output(out, batch: tuple, tail: tuple, inputs: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The result array of a kernel and the array to return.
+
+    Without ``out``: a new array ``(B,) + tail`` (``tail`` alone for a single state) and its
+    reshape to ``batch + tail``. With ``out``: it must be a writeable C-contiguous float64
+    ndarray of shape ``batch + tail`` that shares no memory with the ``inputs`` (the kernels
+    read their inputs while they write); the kernel writes into it and ``out`` is returned.
+    """
+    shape = batch + tail
+    flat = tail if batch == () else (int(np.prod(batch)),) + tail
+    if out is None:
+        res = np.empty(flat)
+        return res, unflatten(res, batch)
+    if not isinstance(out, np.ndarray) or out.dtype != np.float64:
+        raise ValueError(f"out: expected a float64 ndarray, got {type(out).__name__}"
+                         + (f" of {out.dtype}" if isinstance(out, np.ndarray) else ""))
+    if out.shape != shape:
+        raise ValueError(f"out: expected shape {shape}, got {out.shape}")
+    if not (out.flags.c_contiguous and out.flags.writeable):
+        raise ValueError("out: must be C-contiguous and writeable")
+    for name, a in inputs.items():
+        if np.may_share_memory(out, a):
+            raise ValueError(f"out: shares memory with the input {name}")
+    return out.reshape(flat), out
 
 
 def chunks(B: int) -> int:

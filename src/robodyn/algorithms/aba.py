@@ -41,7 +41,7 @@ from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix
                        motion_cross, rotate6, shift_motion, unshift_force, wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -322,13 +322,16 @@ def aligned_placement(i, par, liR, lip, oR, op, d):
             oR[i, r, cc] = Rp[r, 0] * liR[i, 0, cc] + Rp[r, 1] * liR[i, 1, cc] + Rp[r, 2] * liR[i, 2, cc]
 
 
-@inline
 def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
     """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,) (RBDA section 9.2, see
     ``hybrid.py``). ``known[k]``: the acceleration of dof ``k`` is given (all dofs of a joint
     alike); with no dof known this is the ABA. Returns a status (see
-    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular. Inlined
-    into :func:`hybrid_one` (one state) and :func:`aba_range` (a batch loop).
+    ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
+
+    Compiled twice (see below): as :func:`hybrid_one`, the function every single-state
+    caller shares, and inlined into the batch loop :func:`aba_range`, where a call per state
+    would cost about a tenth of the work. Numba's inlining copies a function in time
+    quadratic in its size (a minute or more for this one), so there is no other inlined copy.
 
     Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
     module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
@@ -462,10 +465,8 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     return result_status(check, finite(qdd) and finite(tau))
 
 
-@core
-def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
-    """:func:`hybrid_state` of one state (the compiled function other kernels call)."""
-    return hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws)
+hybrid_one = core(hybrid_state)
+_hybrid_inlined = inline(hybrid_state)
 
 
 @core
@@ -481,8 +482,8 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
     """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`)."""
     for s in range(lo, hi):
-        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
-                                 F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
+        status[s] = _hybrid_inlined(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
+                                    F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
 
 
 @parallel
@@ -503,18 +504,19 @@ def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
 def _aba_packed(ints, packed, q, v, tau, check, qdd):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
-    return aba_one(ints, body, dofs, params, q, v, tau, zero, -1, check, qdd, workspace(ints.shape[0], dofs.shape[0]))
+    return aba_one(ints, body, dofs, params, q, v, tau, zero, NO_WRENCH, check, qdd,
+                   workspace(ints.shape[0], dofs.shape[0]))
 
 
 def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-        armature: bool = True, check_finite: bool = True) -> np.ndarray:
+        armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Forward dynamics: the acceleration produced by joint forces ``tau`` at ``(q, v)``.
 
     ``a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)``
 
     Args:
         q: (..., nq). v, tau: (..., nv). f_ext, f_ext_frame, friction, armature,
-        check_finite: as in :func:`robodyn.rnea`.
+        check_finite, out: as in :func:`robodyn.rnea`.
 
     Returns:
         a: (..., nv), the inverse of :func:`robodyn.rnea`: ``aba(q, v, rnea(q, v, a)) == a``.
@@ -524,21 +526,22 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     """
     k = model._kernel
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
-        qdd = np.empty(model.nv)  # fast path for one state: the kernel checks sizes and values
-        try:
-            if _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite, qdd) == OK:
+        qdd = _inputs.fast_out(out, (model.nv,), q, v, tau)  # fast path for one state: the kernel checks
+        try:  # sizes and values
+            if qdd is not None and _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite,
+                                               qdd) == OK:
                 return qdd
         except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    qdd, result = _inputs.output(out, batch, (model.nv,), x)
     if batch == ():
-        qdd = np.empty(model.nv)
         status = _aba_single(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd)
     else:
         B = x["q"].shape[0]
-        qdd, status = np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
+        status = np.empty(B, dtype=np.int64)
         _aba_batch(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd, status,
                    _inputs.chunks(B))
     bad = _inputs.raise_for_status(model, status, x, "aba")
@@ -549,4 +552,4 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
             f"{model.body_joint_names[i]!r}) is singular, so the forward dynamics is undefined; "
             "give the bodies beyond it mass and inertia about the joint axis (or armature)"
         )
-    return _inputs.unflatten(qdd, batch)
+    return result

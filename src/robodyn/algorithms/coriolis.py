@@ -149,36 +149,39 @@ def _coriolis_packed(ints, packed, q, v, check, C):
     return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 
 
-def _run(model, batch, x, check, what):
+def _run(model, batch, x, check, what, out=None):
+    """The Coriolis matrices of the checked states ``x`` into ``out`` (see ``_inputs.output``):
+    returns ``(C, result)``, the kernel's flat array and the one to return."""
     k = model._kernel
     dofs, q, v = k["dofs"][(False, False)], x["q"], x["v"]
+    C, result = _inputs.output(out, batch, (model.nv, model.nv), x)
     if batch == ():
-        C = np.empty((model.nv, model.nv))
         status = _coriolis_single(k["ints"], k["body"], dofs, q, v, check, C)
     else:
-        B = q.shape[0]
-        C, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
-        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, _inputs.chunks(B))
+        status = np.empty(q.shape[0], dtype=np.int64)
+        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, _inputs.chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x, what)
-    return C
+    return C, result
 
 
-def coriolis_matrix(model, q, v, *, check_finite: bool = True) -> np.ndarray:
+def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Coriolis matrix ``C(q, v)``: (..., nv, nv) for q (..., nq), v (..., nv).
 
     ``C v`` is the Coriolis/centrifugal vector ``nonlinear_effects(q, v) - gravity(q)``,
     ``Mdot - 2C`` is skew-symmetric and ``C_ij = sum_k Gamma_ijk v_k`` with the Christoffel
-    symbols of :func:`christoffel_symbols`. Reference: Echeandia and Wensing (2021).
+    symbols of :func:`christoffel_symbols`. ``out``: an optional (..., nv, nv) C-contiguous
+    float64 array to write into and return (see :func:`robodyn.rnea`). Reference: Echeandia
+    and Wensing (2021).
     """
     k = model._kernel  # fast path for one state: the kernel checks sizes and values
-    C = np.empty((model.nv, model.nv))
+    C = _inputs.fast_out(out, (model.nv, model.nv), q, v)
     try:
-        if _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
+        if C is not None and _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
             return C
     except TypeError:  # not contiguous float64 vectors
         pass
     batch, x = _inputs.states(model, q=q, v=v)
-    return _inputs.unflatten(_run(model, batch, x, check_finite, "coriolis_matrix"), batch)
+    return _run(model, batch, x, check_finite, "coriolis_matrix", out)[1]
 
 
 def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
@@ -195,6 +198,6 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     nv = model.nv
     Q = np.repeat(_inputs.as_batch(x["q"]), nv, axis=0)
     V = np.tile(np.eye(nv), (Q.shape[0] // nv, 1))
-    CC = _run(model, (Q.shape[0],), {"q": Q, "v": V}, check_finite, "christoffel_symbols").reshape(-1, nv, nv, nv)
+    CC = _run(model, (Q.shape[0],), {"q": Q, "v": V}, check_finite, "christoffel_symbols")[0].reshape(-1, nv, nv, nv)
     G = np.ascontiguousarray(CC.transpose(0, 2, 3, 1))  # (B, k, i, j) -> (B, i, j, k)
     return G[0] if batch == () else G.reshape(batch + (nv, nv, nv))

@@ -92,30 +92,31 @@ def _crba_packed(ints, packed, q, check, M):
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
-def crba(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
+def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Joint-space inertia (mass) matrix ``M(q)``, full and symmetric.
 
     q: (..., nq). Returns (..., nv, nv). ``armature=True`` adds the model's reflected rotor
-    inertias on the diagonal (as :func:`robodyn.rnea` and :func:`robodyn.aba` do).
+    inertias on the diagonal (as :func:`robodyn.rnea` and :func:`robodyn.aba` do). ``out``: an
+    optional (..., nv, nv) C-contiguous float64 array to write into and return (see
+    :func:`robodyn.rnea`).
 
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
     k = model._kernel
-    M = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
+    M = _inputs.fast_out(out, (model.nv, model.nv), q)  # fast path for one state: the kernel checks q
     try:
-        if _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
+        if M is not None and _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
             return M
     except (TypeError, KeyError):  # not a contiguous float64 vector (or armature not bool)
         pass
     batch, x = _inputs.states(model, q=q)
     dofs, q = k["dofs"][(False, bool(armature))], x["q"]
+    M, result = _inputs.output(out, batch, (model.nv, model.nv), x)
     if batch == ():
-        M = np.empty((model.nv, model.nv))
         status = _crba_single(k["ints"], k["body"], dofs, q, check_finite, M)
     else:
-        B = q.shape[0]
-        M, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
-        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, _inputs.chunks(B))
+        status = np.empty(q.shape[0], dtype=np.int64)
+        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, _inputs.chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x, "crba")
-    return _inputs.unflatten(M, batch)
+    return result

@@ -25,7 +25,7 @@ from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act
                        wrench_to_local)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import world_placement
 
 
@@ -185,28 +185,29 @@ def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
 def _rnea_packed(ints, packed, q, v, a, check, tau):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
-    return rnea_one(ints, body, dofs, params, q, v, a, zero, -1, check, tau, workspace(ints.shape[0]))
+    return rnea_one(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
-def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None):
-    """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``); errors name
-    the arrays of ``report`` (default ``x``)."""
+def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None,
+        out=None):
+    """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``) into ``out``
+    (see ``_inputs.output``); errors name the arrays of ``report`` (default ``x``)."""
     k = model._kernel
     dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][gravity]
     q, v, a = x["q"], x["v"], x["a"]
+    tau, result = _inputs.output(out, batch, (model.nv,), x)
     if batch == ():
-        tau = np.empty(model.nv)
         status = _rnea_single(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau)
     else:
-        B = q.shape[0]
-        tau, status = np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
-        _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status, _inputs.chunks(B))
+        status = np.empty(q.shape[0], dtype=np.int64)
+        _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status,
+                    _inputs.chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x if report is None else report, what)
-    return _inputs.unflatten(tau, batch)
+    return result
 
 
 def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-         armature: bool = True, check_finite: bool = True) -> np.ndarray:
+         armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Inverse dynamics: the joint forces that produce acceleration ``a`` at state ``(q, v)``.
 
     ``tau = M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i + armature * a + friction(v)``
@@ -220,6 +221,8 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
         friction: add the model's joint friction ``damping v + coulomb sgn(v)``.
         armature: add the model's reflected rotor inertia ``armature * a``.
         check_finite: reject NaN/Inf inputs (turn off only in hot loops with trusted input).
+        out: optional (..., nv) C-contiguous float64 array to write the result into (and
+            return), as in NumPy; it must not overlap the inputs.
 
     Returns:
         tau: (..., nv). For a floating base its first six entries are the base wrench
@@ -231,12 +234,13 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     """
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
         k = model._kernel  # fast path for one state: the kernel checks sizes and values
-        tau = np.empty(model.nv)
+        tau = _inputs.fast_out(out, (model.nv,), q, v, a)
         try:
-            if _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite, tau) == OK:
+            if tau is not None and _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite,
+                                                tau) == OK:
                 return tau
         except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)
+    return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)

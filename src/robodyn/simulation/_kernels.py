@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import inline, kernel
-from ..algorithms._inputs import OK
+from ..algorithms._inputs import CHECKED, NO_WRENCH, OK
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
 from ..algorithms.rnea import rnea_one
@@ -86,7 +86,7 @@ def derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, chec
     ``tau_cmd`` clipped to ``[-limit, limit]`` (written to ``tau``). Returns the ABA status."""
     for k in range(tau.shape[0]):
         tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    status = aba_one(ints, body, dofs, params, q, v, tau, fext, -1, check, a, ws)
+    status = aba_one(ints, body, dofs, params, q, v, tau, fext, NO_WRENCH, check, a, ws)
     chart_rate(ints, q, theta, v, R, thetadot)
     return status
 
@@ -112,7 +112,7 @@ def rate(ints, q, theta, v, R, out):
 @kernel
 def stage(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, tau, thetadot, a, ws, R):
     """Compiled ``derivative`` (with the NaN/Inf check) for the Python-driven integrators."""
-    return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, True, tau, thetadot, a, R, ws)
+    return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, CHECKED, tau, thetadot, a, R, ws)
 
 
 @inline
@@ -159,13 +159,13 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
     ws, qd, vd, ad, acc, zero = cws
     reference_at(breaks, coefs, t, qd, vd, ad)
     if law == PD_GRAVITY:
-        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], -1, True, out, ws)
+        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], NO_WRENCH, CHECKED, out, ws)
         for k in range(out.shape[0]):
             out[k] += gains[0, k] * (qd[k] - q[k]) - gains[1, k] * v[k]
         return st
     for k in range(out.shape[0]):
         acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
-    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], -1, True, out, ws)
+    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], NO_WRENCH, CHECKED, out, ws)
 
 
 @kernel
@@ -194,7 +194,7 @@ def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau
         th[:] = 0.0
         st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, cmd)
         if st == OK:
-            st = derivative(ints, body, dofs, params, fext, limit, q, th, v, cmd, True, T[s], kt[0], A[s], R, ws)
+            st = derivative(ints, body, dofs, params, fext, limit, q, th, v, cmd, CHECKED, T[s], kt[0], A[s], R, ws)
         if st != OK:
             return st, s
         if s == n:
@@ -216,7 +216,7 @@ def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau
             chart_point(ints, q, thi, qi)
             st = law_torque(law, c, gains, breaks, coefs, t + h, qi, vi, tau_cmd, cws, cmd)
             if st == OK:
-                st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, cmd, True, tau, kt[j], ka[j], R, ws)
+                st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, cmd, CHECKED, tau, kt[j], ka[j], R, ws)
             if st != OK:
                 return st, s
         for k in range(nv):

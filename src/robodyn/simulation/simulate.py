@@ -114,11 +114,13 @@ class _Plant:
                      np.ascontiguousarray(model.effort_limit))
         self.ws, self.R = K.stage_workspace(model.nbodies, model.nq, model.nv)
 
+    # The kernels take C-contiguous arrays only (SciPy's integrators hand over strided views),
+    # so that each compiles once.
     def point(self, q0, theta, q):
-        K.point(self.args[0], q0, theta, q)
+        K.point(self.args[0], q0, np.ascontiguousarray(theta), q)
 
     def rate(self, q, theta, v, out):
-        K.rate(self.args[0], q, theta, v, self.R, out)
+        K.rate(self.args[0], q, np.ascontiguousarray(theta), np.ascontiguousarray(v), self.R, out)
 
     def derivative(self, t, q, theta, v, law, z, tau, thetadot, a, zdot):
         """``(theta', a, z')`` into the given arrays; the applied torque into ``tau``."""
@@ -128,7 +130,8 @@ class _Plant:
             cmd = np.asarray(cmd, dtype=float)
             if cmd.shape != (self.model.nv,):
                 raise ValueError(f"controller: returned shape {cmd.shape} at t = {t}, expected ({self.model.nv},)")
-        status = K.stage(*self.args, q, theta, v, cmd, tau, thetadot, a, self.ws, self.R)
+        status = K.stage(*self.args, q, np.ascontiguousarray(theta), np.ascontiguousarray(v), cmd, tau, thetadot, a,
+                         self.ws, self.R)
         if status != OK:
             _raise(self.model, status, t, q, v, cmd)
 
