@@ -197,15 +197,15 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
 
 def fast_out(out, shape: tuple, *inputs):
     """The output array of a single-state fast path: a new ``np.empty(shape)`` when ``out`` is
-    None, ``out`` itself when it is a writeable C-contiguous float64 array of exactly ``shape``
-    that shares no memory with the ``inputs``, else None (the caller then takes its general
-    path, where :func:`output` says what is wrong)."""
+    None, ``out`` itself when :func:`output` accepts it for one state of result shape ``shape``,
+    else None (the caller then takes its general path, which knows the batch shape and raises
+    :func:`output`'s error if ``out`` does not fit it either)."""
     if out is None:
         return np.empty(shape)
-    if (type(out) is np.ndarray and out.dtype is _F8 and out.shape == shape and out.flags.c_contiguous
-            and out.flags.writeable and not any(np.may_share_memory(out, x) for x in inputs)):
-        return out
-    return None
+    try:
+        return output(out, (), shape, dict(enumerate(inputs)))[1]
+    except ValueError:
+        return None
 
 
 def output(out, batch: tuple, tail: tuple, inputs: dict) -> tuple[np.ndarray, np.ndarray]:
