@@ -35,9 +35,10 @@ def test_quadrant_boundaries_and_multiples_of_half_pi():
 
 
 def test_tiny_angles_are_exact():
-    for x in (0.0, 1e-300, -1e-300, 5e-324, 1e-9):
+    for x in (0.0, -0.0, 1e-300, -1e-300, 5e-324, 1e-9, -7e-9, np.nextafter(2.0 ** -27, 0.0), 2.0 ** -27, 1e-8):
         s, c = sincos(x)
-        assert s == x and c == 1.0
+        assert s == np.sin(x) and c == np.cos(x)
+        assert np.signbit(s) == np.signbit(x)  # sin(-0.0) is -0.0, as in C
 
 
 @pytest.mark.parametrize("x", [np.nan, np.inf, -np.inf, REDUCE_MAX * 1.0001, -1e300, 1e22])

@@ -495,6 +495,26 @@ def test_cli_derive(tmp_path, capsys):
     assert_rel(call_c(lib.planar_2r_g, 2, q), rd.gravity(model, q), 1e-12, "g")
 
 
+def test_cli_derive_expanded_form(tmp_path, capsys):
+    """``--form expanded`` writes every term expanded; the code computes the same M and tau."""
+    from robodyn.cli import main
+
+    cdirs = {form: tmp_path / form for form in ("auto", "expanded")}
+    for form, cdir in cdirs.items():
+        assert main(["derive", "elbow_3r", "--c", str(cdir), "--form", form]) == 0
+    out = capsys.readouterr().out
+    assert "(M, g, tau by the recursions, C expanded)" in out and "(every term expanded)" in out
+    sources = {form: (cdir / "elbow_3r_dynamics.c").read_text() for form, cdir in cdirs.items()}
+    assert sources["auto"] != sources["expanded"]
+    model = rd.models.load("elbow_3r")
+    q, qd, qdd = np.array([0.3, -1.1, 0.7]), np.array([0.5, 0.2, -0.4]), np.array([1.0, -2.0, 0.5])
+    for form, cdir in cdirs.items():
+        lib = compile_c({"elbow_3r_dynamics.c": None, "elbow_3r_dynamics.h": None}, cdir, f"e3r_{form}")
+        assert_rel(call_c(lib.elbow_3r_M, 9, q).reshape(3, 3), rd.crba(model, q), 1e-12, f"M ({form})")
+        assert_rel(call_c(lib.elbow_3r_tau, 3, q, qd, qdd), rd.rnea(model, q, qd, qdd, friction=False), 1e-12,
+                   f"tau ({form})")
+
+
 def test_cli_derive_errors(capsys):
     from robodyn.cli import main
 

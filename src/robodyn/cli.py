@@ -179,6 +179,9 @@ def main(argv=None) -> int:
     p.add_argument("--method", choices=("lagrange", "newton_euler"), default="lagrange")
     p.add_argument("--latex", metavar="FILE", help="write a LaTeX document of every term")
     p.add_argument("--c", metavar="DIR", dest="c_dir", help="write C source and header into DIR")
+    p.add_argument("--form", choices=("auto", "expanded"), default="auto",
+                   help="how the C code evaluates the terms: auto (M, g, tau by the recursions, C expanded) "
+                        "or expanded (every term expanded)")
     p.set_defaults(func=cmd_derive)
 
     args = parser.parse_args(argv)

@@ -12,7 +12,8 @@ within 2 units in the last place of the library values:
    ``sin r = r + r z P(z)``, ``cos r = 1 - z/2 + z^2 Q(z)``, ``z = r^2``.
 3. The quadrant ``n mod 4`` swaps and negates ``(sin r, cos r)``, without branches.
 
-Angles beyond ``REDUCE_MAX`` (16,000 turns), and NaN or infinite ones, go to the library.
+Angles beyond ``REDUCE_MAX`` (16,000 turns), and NaN or infinite ones, go to the library;
+angles below ``TINY`` in magnitude are their own sine (``sin(-0.0) = -0.0``, as in C).
 
 This function is compiled with floating-point contraction (fused multiply-add) only: the
 reassociation allowed elsewhere would merge the three-part reduction into one product and
@@ -26,6 +27,7 @@ import numpy as np
 from ._jit import exact
 
 REDUCE_MAX = 1e5
+TINY = 2.0 ** -27  # below it, x^3 / 6 < ulp(x) / 2 and x^2 / 2 < ulp(1) / 2
 TWO_OVER_PI = 0.6366197723675814
 # pi/2 = PIO2_1 + PIO2_2 + PIO2_3; PIO2_1 and PIO2_2 have 24 significant bits, so their
 # products with n (|n| < 2^17) are exact.
@@ -39,6 +41,8 @@ def sincos(x):
     """``(sin x, cos x)``."""
     if not abs(x) <= REDUCE_MAX:
         return np.sin(x), np.cos(x)
+    if abs(x) < TINY:  # sin x = x and cos x = 1 to the last bit; keeps the sign of -0.0
+        return x, 1.0
     n = np.floor(x * TWO_OVER_PI + 0.5)
     r = ((x - n * PIO2_1) - n * PIO2_2) - n * PIO2_3
     z = r * r

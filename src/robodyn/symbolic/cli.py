@@ -1,4 +1,4 @@
-"""``robodyn derive MODEL [--method lagrange|newton_euler] [--latex FILE] [--c DIR]``."""
+"""``robodyn derive MODEL [--method lagrange|newton_euler] [--latex FILE] [--c DIR] [--form auto|expanded]``."""
 
 from __future__ import annotations
 
@@ -10,8 +10,9 @@ from .equations import equations_of_motion
 
 def run_derive(model, args) -> int:
     """Derive the closed-form terms of ``model``, print a summary (the terms themselves for
-    up to 3 joints), and write the LaTeX document and the C code when asked (``M``, ``g``,
-    ``tau`` as the straight-line code of the recursions, ``C`` expanded: see
+    up to 3 joints), and write the LaTeX document and the C code when asked (``--form
+    auto``: ``M``, ``g``, ``tau`` as the straight-line code of the recursions, ``C``
+    expanded; ``--form expanded``: every term expanded; see
     :meth:`.EquationsOfMotion.program`)."""
     t0 = time.perf_counter()
     eom = equations_of_motion(model, method=args.method)
@@ -29,7 +30,8 @@ def run_derive(model, args) -> int:
             f.write(eom.latex())
         print(f"  LaTeX: {args.latex}")
     if args.c_dir:
-        files = eom.to_c(args.c_dir)
-        print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)} (M, g, tau by the recursions, C expanded)")
+        files = eom.to_c(args.c_dir, form=args.form)
+        how = "M, g, tau by the recursions, C expanded" if args.form == "auto" else "every term expanded"
+        print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)} ({how})")
     sys.stdout.flush()
     return 0
