@@ -18,6 +18,10 @@ after its own first dof ``k_i``: the columns ``< k_i`` of ``F_i`` and ``u_i`` ar
 only the upper triangle (columns ``>= k_i`` of the rows of body ``i``) is computed, then
 mirrored.
 
+Coordinates: as in the ABA (``aba.py``), each body's quantities are expressed at its origin
+with the world's axes, so that ``iX_p`` is a pure shift by the vector ``d_i`` between the
+origins (:func:`robodyn.spatial.congruence_shift`, ``unshift_force``, ``shift_motion``).
+
 Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
 algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Table 7.1.
 """
@@ -28,35 +32,54 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, kernel, parallel
-from ..spatial import congruence_to_parent, force_act, inertia_matrix, motion_act_inv
+from ..joint_kernels import body_placement
+from ..spatial import congruence_shift, inertia_matrix, inertia_rotated, rotate6, shift_motion, unshift_force
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
-from .aba import articulated_inertia, joint_inertia
-from .kinematics import placements
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
+from .aba import aligned_placement, articulated_inertia, joint_inertia
 
 
 @kernel
 def workspace(nb, nv):
-    return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3), np.empty((nb, 6, 6)),
-            np.empty((nv, 6)), np.empty((nv, 6)), np.empty((nb, 6, nv)), np.empty((3, 3, 3)), np.empty((3, 3)),
-            np.empty((6, 6)), np.empty((6, 12)), np.empty((6, 6)), np.empty(6), np.empty(6))
+    """Scratch of :func:`minv_one`, carved from one buffer: ``(buffer, liR, lip, oR, op, d, Rj,
+    IA, S, U, Dinv, F, UD, G, Ia, t1, t2)``; ``F[i, col]`` is column ``col`` of body ``i``'s
+    6 x nv matrix ``F_i``."""
+    buf = np.empty((POSES_SIZE_NB + 39 + 6 * nv) * nb + 18 * nv + POSES_SIZE + 156)
+    (liR, lip, oR, op, Rj, _), o = poses(buf, 0, nb)
+    d, o = take(buf, o, (nb, 3))
+    IA, o = take(buf, o, (nb, 6, 6))
+    S, o = take(buf, o, (nv, 6))
+    U, o = take(buf, o, (nv, 6))
+    Dinv, o = take(buf, o, (nv, 6))
+    F, o = take(buf, o, (nb, nv, 6))
+    UD, o = take(buf, o, (6, 6))
+    G, o = take(buf, o, (6, 12))
+    Ia, o = take(buf, o, (6, 6))
+    t1, o = take(buf, o, (6,))
+    t2, o = take(buf, o, (6,))
+    return buf, liR, lip, oR, op, d, Rj, IA, S, U, Dinv, F, UD, G, Ia, t1, t2
 
 
 @core
 def minv_one(ints, body, dofs, q, check, Minv, ws):
     """``Minv`` (nv, nv) at ``q``; returns a status (see ``_inputs``), ``i + 1`` when the
     articulated inertia of body ``i`` is singular."""
-    liR, lip, Rj, pj, IA, U, Dinv, F, B3, PB, UD, G, Ia, t1, t2 = ws
+    _, liR, lip, oR, op, d, Rj, IA, S, U, Dinv, F, UD, G, Ia, t1, t2 = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
     if check and not finite(q):
         return NONFINITE
-    if not placements(ints, body, q, liR, lip, Rj, pj):
-        return BAD_QUATERNION
+    # Pass 1: placements, motion subspaces S[k] and rigid-body inertias in world axes
     for i in range(nb):
-        inertia_matrix(body[i, 15:25], IA[i])
-        F[i, :, :] = 0.0
+        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+            return BAD_QUATERNION
+        aligned_placement(i, ints[i, 0], liR, lip, oR, op, d)
+        for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
+            rotate6(oR[i], dofs[k], S[k])
+        inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i])
+        F[i, ints[i, 3]:, :] = 0.0  # only the columns >= k_i are used
     # Pass 2: articulated inertias and the bias forces of the unit joint forces;
     # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it
     for i in range(nb - 1, -1, -1):
@@ -65,30 +88,28 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
             for col in range(iv, nv):
                 s = 0.0
                 for r in range(6):
-                    s += dofs[k, r] * F[i, r, col]
+                    s += S[k, r] * F[i, col, r]
                 Minv[k, col] = (1.0 if col == k else 0.0) - s
-        if not joint_inertia(IA[i], dofs, dofs, iv, n, U, Dinv, G):
+        if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
             return i + 1
         if par >= 0:
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
-            congruence_to_parent(liR[i], lip[i], Ia, B3, PB, IA[par])
+            congruence_shift(d[i], Ia, IA[par])
             for col in range(iv, nv):
                 for r in range(6):
-                    s = F[i, r, col]
+                    s = F[i, col, r]
                     for j in range(n):
                         s += UD[r, j] * Minv[iv + j, col]
                     t2[r] = s
-                force_act(liR[i], lip[i], t2, t1)
+                unshift_force(d[i], t2, t1)
                 for r in range(6):
-                    F[par, r, col] += t1[r]
+                    F[par, col, r] += t1[r]
     # Pass 3: accelerations of the unit joint forces (F now holds the body accelerations)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
         for col in range(iv, nv):
             if par >= 0:
-                for r in range(6):
-                    t1[r] = F[par, r, col]
-                motion_act_inv(liR[i], lip[i], t1, t2)
+                shift_motion(d[i], F[par, col], t2)
             else:
                 t2[:] = 0.0
             for k in range(iv, iv + n):
@@ -102,9 +123,9 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                     s += Dinv[j, k] * t1[k]
                 Minv[j, col] = s
                 for r in range(6):
-                    t2[r] += dofs[j, r] * s
+                    t2[r] += S[j, r] * s
             for r in range(6):
-                F[i, r, col] = t2[r]
+                F[i, col, r] = t2[r]
     for k in range(nv):
         for col in range(k + 1, nv):
             Minv[col, k] = Minv[k, col]
