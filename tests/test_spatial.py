@@ -51,7 +51,13 @@ def into(helper, shape, nargs=2):
     return call
 
 
-_congruence_shift = into(sp.congruence_shift, (6, 6))
+@njit
+def _congruence_shift(d, A, lower=True):
+    out = np.zeros((6, 6))
+    sp.congruence_shift(d, sp.upper_triangle(A), out, lower)
+    return out
+
+
 _shift_motion, _unshift_force, _rotate6 = (into(h, 6) for h in (sp.shift_motion, sp.unshift_force, sp.rotate6))
 _inertia_act = into(sp.inertia_act, 10, nargs=3)
 
@@ -76,6 +82,8 @@ def test_congruence_shift_is_the_transform_without_rotation(trial):
     X = np.linalg.inv(motion_transform(np.eye(3), d))  # parent-to-child: the shift by d
     expected = X.T @ A @ X
     np.testing.assert_allclose(_congruence_shift(d, A), expected, rtol=1e-13, atol=1e-13 * np.abs(expected).max())
+    upper = _congruence_shift(d, A, False)  # the lower triangle of out left alone
+    np.testing.assert_allclose(upper, np.triu(expected), rtol=1e-13, atol=1e-13 * np.abs(expected).max())
     np.testing.assert_allclose(_congruence_to_parent(np.eye(3), d, A), expected, rtol=1e-13,
                                atol=1e-13 * np.abs(expected).max())
 

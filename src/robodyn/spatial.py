@@ -377,31 +377,57 @@ def congruence_to_parent(R, p, A, B, PB, out):
 
 
 @inline
-def congruence_shift(d, A, out):
-    """``out += X^T A X`` for a symmetric 6 x 6 ``A`` at the point ``d`` and ``X`` the shift
-    by ``d`` (:func:`congruence_to_parent` with ``R = 1``). With ``P = [d]x``:
-    ``X^T A X = [[A11, C], [C^T, A22 + (P A12)^T + P C]]``, ``C = A12 - A11 P``."""
+def upper_triangle(A):
+    """The 21 entries of the upper triangle of a symmetric 6 x 6 ``A``, row by row:
+    ``(A00, A01, ..., A05, A11, ..., A15, A22, ..., A55)``."""
+    return (A[0, 0], A[0, 1], A[0, 2], A[0, 3], A[0, 4], A[0, 5], A[1, 1], A[1, 2], A[1, 3], A[1, 4], A[1, 5],
+            A[2, 2], A[2, 3], A[2, 4], A[2, 5], A[3, 3], A[3, 4], A[3, 5], A[4, 4], A[4, 5], A[5, 5])
+
+
+@inline
+def mirror_upper(A):
+    """Copy the upper triangle of the 6 x 6 ``A`` onto its lower one."""
+    for r in range(1, 6):
+        for c in range(r):
+            A[r, c] = A[c, r]
+
+
+@inline
+def congruence_shift(d, a, out, lower):
+    """``out += X^T A X`` for a symmetric 6 x 6 ``A`` at the point ``d``, given by its upper
+    triangle ``a`` (:func:`upper_triangle`), and ``X`` the shift by ``d``
+    (:func:`congruence_to_parent` with ``R = 1``). With ``P = [d]x``:
+    ``X^T A X = [[A11, C], [C^T, A22 + (P A12)^T + P C]]``, ``C = A12 - A11 P``.
+    Only the upper triangle of ``out`` is updated unless ``lower`` is True.
+
+    Taking ``A`` as values lets a caller pass one it computes without storing it (the ABA's
+    ``IA_i - U_i D_i^-1 U_i^T``)."""
+    (a00, a01, a02, a03, a04, a05, a11, a12, a13, a14, a15, a22, a23, a24, a25, a33, a34, a35, a44, a45,
+     a55) = a
     d0, d1, d2 = d[0], d[1], d[2]
     # C = A12 - A11 P: row r of A11 P is (row r of A11) x d
-    c00 = A[0, 3] - (A[0, 1] * d2 - A[0, 2] * d1)
-    c01 = A[0, 4] - (A[0, 2] * d0 - A[0, 0] * d2)
-    c02 = A[0, 5] - (A[0, 0] * d1 - A[0, 1] * d0)
-    c10 = A[1, 3] - (A[1, 1] * d2 - A[1, 2] * d1)
-    c11 = A[1, 4] - (A[1, 2] * d0 - A[1, 0] * d2)
-    c12 = A[1, 5] - (A[1, 0] * d1 - A[1, 1] * d0)
-    c20 = A[2, 3] - (A[2, 1] * d2 - A[2, 2] * d1)
-    c21 = A[2, 4] - (A[2, 2] * d0 - A[2, 0] * d2)
-    c22 = A[2, 5] - (A[2, 0] * d1 - A[2, 1] * d0)
+    c00 = a03 - (a01 * d2 - a02 * d1)
+    c01 = a04 - (a02 * d0 - a00 * d2)
+    c02 = a05 - (a00 * d1 - a01 * d0)
+    c10 = a13 - (a11 * d2 - a12 * d1)
+    c11 = a14 - (a12 * d0 - a01 * d2)
+    c12 = a15 - (a01 * d1 - a11 * d0)
+    c20 = a23 - (a12 * d2 - a22 * d1)
+    c21 = a24 - (a22 * d0 - a02 * d2)
+    c22 = a25 - (a02 * d1 - a12 * d0)
     # E = (P A12)^T + P C: column c of P Y is d x (column c of Y); (P A12)^T[r, c] = (P A12)[c, r]
-    e00 = (d1 * A[2, 3] - d2 * A[1, 3]) + (d1 * c20 - d2 * c10)
-    e01 = (d2 * A[0, 3] - d0 * A[2, 3]) + (d1 * c21 - d2 * c11)
-    e02 = (d0 * A[1, 3] - d1 * A[0, 3]) + (d1 * c22 - d2 * c12)
-    e11 = (d2 * A[0, 4] - d0 * A[2, 4]) + (d2 * c01 - d0 * c21)
-    e12 = (d0 * A[1, 4] - d1 * A[0, 4]) + (d2 * c02 - d0 * c22)
-    e22 = (d0 * A[1, 5] - d1 * A[0, 5]) + (d0 * c12 - d1 * c02)
-    for r in range(3):
-        for cc in range(3):
-            out[r, cc] += A[r, cc]
+    e00 = (d1 * a23 - d2 * a13) + (d1 * c20 - d2 * c10)
+    e01 = (d2 * a03 - d0 * a23) + (d1 * c21 - d2 * c11)
+    e02 = (d0 * a13 - d1 * a03) + (d1 * c22 - d2 * c12)
+    e11 = (d2 * a04 - d0 * a24) + (d2 * c01 - d0 * c21)
+    e12 = (d0 * a14 - d1 * a04) + (d2 * c02 - d0 * c22)
+    e22 = (d0 * a15 - d1 * a05) + (d0 * c12 - d1 * c02)
+    out[0, 0] += a00
+    out[0, 1] += a01
+    out[0, 2] += a02
+    out[1, 1] += a11
+    out[1, 2] += a12
+    out[2, 2] += a22
     out[0, 3] += c00
     out[0, 4] += c01
     out[0, 5] += c02
@@ -411,24 +437,14 @@ def congruence_shift(d, A, out):
     out[2, 3] += c20
     out[2, 4] += c21
     out[2, 5] += c22
-    out[3, 0] += c00
-    out[4, 0] += c01
-    out[5, 0] += c02
-    out[3, 1] += c10
-    out[4, 1] += c11
-    out[5, 1] += c12
-    out[3, 2] += c20
-    out[4, 2] += c21
-    out[5, 2] += c22
-    out[3, 3] += A[3, 3] + e00
-    out[3, 4] += A[3, 4] + e01
-    out[4, 3] += A[4, 3] + e01
-    out[3, 5] += A[3, 5] + e02
-    out[5, 3] += A[5, 3] + e02
-    out[4, 4] += A[4, 4] + e11
-    out[4, 5] += A[4, 5] + e12
-    out[5, 4] += A[5, 4] + e12
-    out[5, 5] += A[5, 5] + e22
+    out[3, 3] += a33 + e00
+    out[3, 4] += a34 + e01
+    out[3, 5] += a35 + e02
+    out[4, 4] += a44 + e11
+    out[4, 5] += a45 + e12
+    out[5, 5] += a55 + e22
+    if lower:
+        mirror_upper(out)
 
 
 @inline

@@ -37,8 +37,8 @@ from numba import boolean, prange
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..joint_kernels import body_placement, friction_torque
 from ..joints import FREE
-from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, momentum,
-                       motion_cross, rotate6, shift_motion, unshift_force, wrench_to_aligned)
+from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
+                       momentum, motion_cross, rotate6, shift_motion, unshift_force, upper_triangle, wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
@@ -222,23 +222,25 @@ def joint_acceleration(S, U, Dinv, u, iv, n, acc_i, qdd, t):
 
 
 @inline
-def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, Ia, pa, lo, hi):
+def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u, t, pa, lo, hi):
     """Pass 2 of the ABA for a joint of one dof ``iv`` (the common case, written out):
     ``U = IA_i S``, ``D = S^T U + armature``, ``u = tau_f - S^T pA_i`` (``tau_f``: the joint
-    force less friction), the inertia passed to the parent ``Ia = IA_i - U U^T / D``
-    (symmetric by construction) and the bias force ``pa = pA_i + IA_i c_i + U (u - U^T c_i) / D``
-    (``= pA_i + Ia c_i + U u / D``). ``S`` is zero outside ``lo <= r < hi`` (``(3, 6)``: a
-    rotation about an axis through the origin, ``(0, 3)``: a translation, ``(0, 6)``: any
-    motion); callers pass constants, so the loops unroll. ``t`` (6,) is scratch. Returns False
-    when ``D`` is singular (see :func:`joint_inertia`)."""
+    force less friction) and the bias force passed to the parent
+    ``pa = pA_i + IA_i c_i + U (u - U^T c_i) / D`` (``= pA_i + Ia c_i + U u / D``, with ``Ia``
+    from :func:`single_dof_articulated`). Reads the upper triangle of ``IA_i`` only. ``S`` is
+    zero outside ``lo <= r < hi`` (``(3, 6)``: a rotation about an axis through the origin,
+    ``(0, 3)``: a translation, ``(0, 6)``: any motion); callers pass constants, so the loops
+    unroll. ``t`` (6,) is scratch. Returns False when ``D`` is singular (see
+    :func:`joint_inertia`)."""
     c0, c1, c2, c3, c4, c5 = c_i[0], c_i[1], c_i[2], c_i[3], c_i[4], c_i[5]
     D, Uc, Sp = armature, 0.0, 0.0
     for r in range(6):
         ur = 0.0
         for j in range(lo, hi):
-            ur += IA_i[r, j] * S[j]
+            ur += IA_i[min(r, j), max(r, j)] * S[j]
         U_k[r] = ur
-        t[r] = IA_i[r, 0] * c0 + IA_i[r, 1] * c1 + IA_i[r, 2] * c2 + IA_i[r, 3] * c3 + IA_i[r, 4] * c4 + IA_i[r, 5] * c5
+        t[r] = (IA_i[min(r, 0), max(r, 0)] * c0 + IA_i[min(r, 1), max(r, 1)] * c1 + IA_i[min(r, 2), max(r, 2)] * c2
+                + IA_i[min(r, 3), max(r, 3)] * c3 + IA_i[min(r, 4), max(r, 4)] * c4 + IA_i[min(r, 5), max(r, 5)] * c5)
         Uc += ur * c_i[r]
     for j in range(lo, hi):
         D += S[j] * U_k[j]
@@ -252,12 +254,22 @@ def articulate_single_dof(IA_i, S, armature, c_i, pA_i, tau_f, iv, U_k, Dinv, u,
     uh = (uk - Uc) * dinv
     for r in range(6):
         pa[r] = pA_i[r] + t[r] + U_k[r] * uh
-        ud = U_k[r] * dinv
-        for cc in range(r, 6):
-            x = IA_i[r, cc] - ud * U_k[cc]
-            Ia[r, cc] = x
-            Ia[cc, r] = x
     return True
+
+
+@inline
+def single_dof_articulated(IA_i, U_k, dinv):
+    """The upper triangle (:func:`robodyn.spatial.upper_triangle`) of the inertia a joint of
+    one dof passes to its parent, ``Ia = IA_i - U U^T / D``, from the upper triangle of
+    ``IA_i``: values, never stored (:func:`robodyn.spatial.congruence_shift` takes them)."""
+    u0, u1, u2, u3, u4, u5 = U_k[0], U_k[1], U_k[2], U_k[3], U_k[4], U_k[5]
+    w0, w1, w2, w3, w4, w5 = u0 * dinv, u1 * dinv, u2 * dinv, u3 * dinv, u4 * dinv, u5 * dinv
+    return (IA_i[0, 0] - w0 * u0, IA_i[0, 1] - w0 * u1, IA_i[0, 2] - w0 * u2, IA_i[0, 3] - w0 * u3,
+            IA_i[0, 4] - w0 * u4, IA_i[0, 5] - w0 * u5, IA_i[1, 1] - w1 * u1, IA_i[1, 2] - w1 * u2,
+            IA_i[1, 3] - w1 * u3, IA_i[1, 4] - w1 * u4, IA_i[1, 5] - w1 * u5, IA_i[2, 2] - w2 * u2,
+            IA_i[2, 3] - w2 * u3, IA_i[2, 4] - w2 * u4, IA_i[2, 5] - w2 * u5, IA_i[3, 3] - w3 * u3,
+            IA_i[3, 4] - w3 * u4, IA_i[3, 5] - w3 * u5, IA_i[4, 4] - w4 * u4, IA_i[4, 5] - w4 * u5,
+            IA_i[5, 5] - w5 * u5)
 
 
 @inline
@@ -370,52 +382,60 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
             for r in range(6):
                 pA[i, r] -= t1[r]
     # Pass 2: articulated inertias, the joints of known acceleration held rigid; each body
-    # passes Ia and pa to its parent: IA_p += iX_p^T Ia iX_p, pA_p += iX_p^T pa
+    # passes Ia and pa to its parent: IA_p += iX_p^T Ia iX_p, pA_p += iX_p^T pa. Children add
+    # to the upper triangle of IA_p only (the joints of one dof read no more); the other
+    # joints complete theirs first.
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if known[iv]:
-            matvec6(IA[i], c[i], t1)
-            for r in range(6):
-                t2[r] = pA[i, r] + t1[r]
-                for cc in range(6):
-                    Ia[r, cc] = IA[i, r, cc]
-        elif n == 1:
+        if n == 1 and not known[iv]:
             tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, v, iv), ints[i, 5]
             if axis >= 3:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
-                                           Ia, t2, 3, 6)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
+                                           3, 6)
             elif axis >= 0:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
-                                           Ia, t2, 0, 3)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
+                                           0, 3)
             else:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1,
-                                           Ia, t2, 0, 6)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
+                                           0, 6)
             if not ok:
-                return i + 1
-        else:
-            for k in range(iv, iv + n):
-                s = 0.0
-                for r in range(6):
-                    s += S[k, r] * pA[i, r]
-                u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
-            if free_root(ints, dofs, i):
-                continue  # solved in pass 3
-            if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
                 return i + 1
             if par < 0:
                 continue
-            articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
-            matvec6(Ia, c[i], t1)
-            for r in range(6):
-                s = pA[i, r] + t1[r]
-                for j in range(n):
-                    s += UD[r, j] * u[iv + j]
-                t2[r] = s
-        if par >= 0:
-            congruence_shift(d[i], Ia, IA[par])
-            unshift_force(d[i], t2, t1)
-            for r in range(6):
-                pA[par, r] += t1[r]
+            Ia_upper = single_dof_articulated(IA[i], U[iv], Dinv[iv, 0])
+        else:
+            mirror_upper(IA[i])
+            if known[iv]:
+                matvec6(IA[i], c[i], t1)
+                for r in range(6):
+                    t2[r] = pA[i, r] + t1[r]
+                if par < 0:
+                    continue
+                Ia_upper = upper_triangle(IA[i])
+            else:
+                for k in range(iv, iv + n):
+                    s = 0.0
+                    for r in range(6):
+                        s += S[k, r] * pA[i, r]
+                    u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
+                if free_root(ints, dofs, i):
+                    continue  # solved in pass 3
+                if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
+                    return i + 1
+                if par < 0:
+                    continue
+                articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
+                matvec6(Ia, c[i], t1)
+                for r in range(6):
+                    s = pA[i, r] + t1[r]
+                    for j in range(n):
+                        s += UD[r, j] * u[iv + j]
+                    t2[r] = s
+                Ia_upper = upper_triangle(Ia)
+        congruence_shift(d[i], Ia_upper, IA[par], False)
+        unshift_force(d[i], t2, t1)
+        for r in range(6):
+            pA[par, r] += t1[r]
     # Pass 3: accelerations of the joints of unknown acceleration, forces of the others;
     # a_0 = -g needs no shift to a root's origin (its angular part is zero)
     for i in range(nb):

@@ -33,7 +33,8 @@ from numba import prange
 
 from .._jit import core, kernel, parallel
 from ..joint_kernels import body_placement
-from ..spatial import congruence_shift, inertia_matrix, inertia_rotated, rotate6, shift_motion, unshift_force
+from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shift_motion, unshift_force,
+                       upper_triangle)
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -94,7 +95,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
             return i + 1
         if par >= 0:
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
-            congruence_shift(d[i], Ia, IA[par])
+            congruence_shift(d[i], upper_triangle(Ia), IA[par], True)
             for col in range(iv, nv):
                 for r in range(6):
                     s = F[i, col, r]
