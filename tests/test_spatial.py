@@ -63,9 +63,9 @@ _inertia_act = into(sp.inertia_act, 10, nargs=3)
 
 
 @njit
-def _inertia_matrix(theta):
-    out = np.empty((6, 6))
-    sp.inertia_matrix(theta, out)
+def _inertia_matrix(theta, lower=True):
+    out = np.zeros((6, 6))
+    sp.inertia_matrix(theta, out, lower)
     return out
 
 
@@ -104,6 +104,7 @@ def test_inertia_act_and_rotation(trial):
     theta = np.concatenate([[2.0], rng.standard_normal(3), rng.standard_normal(6)])
     X_inv = np.linalg.inv(motion_transform(R, p))
     expected = X_inv.T @ _inertia_matrix(theta) @ X_inv  # the inertia expressed in the parent
+    np.testing.assert_array_equal(_inertia_matrix(theta, False), np.triu(_inertia_matrix(theta)))
     np.testing.assert_allclose(_inertia_matrix(_inertia_act(R, p, theta)), expected, rtol=1e-12, atol=1e-12)
     rotated = _inertia_act(R, np.zeros(3), theta)
     np.testing.assert_allclose(_inertia_matrix(np.array(sp.inertia_rotated(R, theta))),

@@ -284,17 +284,19 @@ def inertia_act(R, p, theta, out):
 
 
 @inline
-def inertia_matrix(theta, out):
+def inertia_matrix(theta, out, lower):
     """The 6 x 6 spatial inertia matrix ``[[m 1, -h x], [h x, I_o]]`` of 10 parameters (an
-    array or a tuple)."""
+    array or a tuple); its upper triangle only unless ``lower`` is True."""
     mass, hx, hy, hz = theta[0], theta[1], theta[2], theta[3]
     # rows 0-2: [m 1, -[h]x]; rows 3-5: [[h]x, I_o]
     out[0, 0], out[0, 1], out[0, 2], out[0, 3], out[0, 4], out[0, 5] = mass, 0.0, 0.0, 0.0, hz, -hy
-    out[1, 0], out[1, 1], out[1, 2], out[1, 3], out[1, 4], out[1, 5] = 0.0, mass, 0.0, -hz, 0.0, hx
-    out[2, 0], out[2, 1], out[2, 2], out[2, 3], out[2, 4], out[2, 5] = 0.0, 0.0, mass, hy, -hx, 0.0
-    out[3, 0], out[3, 1], out[3, 2], out[3, 3], out[3, 4], out[3, 5] = 0.0, -hz, hy, theta[4], theta[5], theta[7]
-    out[4, 0], out[4, 1], out[4, 2], out[4, 3], out[4, 4], out[4, 5] = hz, 0.0, -hx, theta[5], theta[6], theta[8]
-    out[5, 0], out[5, 1], out[5, 2], out[5, 3], out[5, 4], out[5, 5] = -hy, hx, 0.0, theta[7], theta[8], theta[9]
+    out[1, 1], out[1, 2], out[1, 3], out[1, 4], out[1, 5] = mass, 0.0, -hz, 0.0, hx
+    out[2, 2], out[2, 3], out[2, 4], out[2, 5] = mass, hy, -hx, 0.0
+    out[3, 3], out[3, 4], out[3, 5] = theta[4], theta[5], theta[7]
+    out[4, 4], out[4, 5] = theta[6], theta[8]
+    out[5, 5] = theta[9]
+    if lower:
+        mirror_upper(out)
 
 
 @inline

@@ -11,20 +11,35 @@ so the memory lives as long as the tuple.
 
 from __future__ import annotations
 
-from numba import carray, types
+from numba import types
+from numba.core import cgutils
 from numba.extending import intrinsic
 
 from .._jit import inline
 
 
 @intrinsic
-def _address(typingctx, arr, offset):
-    """Pointer to ``arr.data + offset`` (in elements) of a contiguous array."""
-    sig = types.CPointer(arr.dtype)(arr, offset)
+def _view(typingctx, buf, offset, shape):
+    """The C-contiguous array of ``shape`` (a tuple of ints) starting at ``buf[offset]``,
+    sharing ``buf``'s memory and owning none (like ``carray``, and usable in the kernels
+    compiled without reference counting)."""
+    ndim = len(shape)
+    arrty = types.Array(buf.dtype, ndim, "C")
+    sig = arrty(buf, offset, shape)
 
     def codegen(context, builder, signature, args):
-        ary = context.make_array(signature.args[0])(context, builder, args[0])
-        return builder.gep(ary.data, [args[1]])
+        src = context.make_array(signature.args[0])(context, builder, args[0])
+        data = builder.gep(src.data, [args[1]])
+        dims = [context.cast(builder, v, ty, types.intp)
+                for v, ty in zip(cgutils.unpack_tuple(builder, args[2], ndim), signature.args[2])]
+        itemsize = context.get_constant(types.intp, context.get_abi_sizeof(context.get_data_type(buf.dtype)))
+        strides = [itemsize] * ndim
+        for k in range(ndim - 2, -1, -1):
+            strides[k] = builder.mul(strides[k + 1], dims[k + 1])
+        out = context.make_array(arrty)(context, builder)
+        context.populate_array(out, data=data, shape=cgutils.pack_array(builder, dims),
+                               strides=cgutils.pack_array(builder, strides), itemsize=itemsize, meminfo=None)
+        return out._getvalue()
 
     return sig, codegen
 
@@ -38,7 +53,7 @@ def take(buf, o, shape):
         n *= s
     if o + n > buf.shape[0]:  # a layout error in the caller: fail loudly, never overrun
         raise IndexError("workspace buffer too small")
-    return carray(_address(buf, o), shape), o + n
+    return _view(buf, o, shape), o + n
 
 
 POSES_SIZE_NB, POSES_SIZE = 24, 12  # entries of :func:`poses`: 24 nb + 12

@@ -47,12 +47,9 @@ from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finit
 SINGULAR_RTOL = 1e-12
 
 
-@kernel
-def workspace(nb, nv):
-    """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
-    Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
-    of the joint forces and ``known`` is all False (no joint of known acceleration)."""
-    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
+@inline
+def workspace_views(buf, nb, nv):
+    """The scratch arrays of :func:`hybrid_state` carved from ``buf`` (see :func:`workspace`)."""
     P, o = poses(buf, 0, nb)
     vel, o = take(buf, o, (nb, 6))
     c, o = take(buf, o, (nb, 6))
@@ -70,7 +67,16 @@ def workspace(nb, nv):
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    return buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau, np.zeros(nv, dtype=np.bool_)
+    return P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau
+
+
+@kernel
+def workspace(nb, nv):
+    """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
+    Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
+    of the joint forces and ``known`` is all False (no joint of known acceleration)."""
+    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
+    return (buf,) + workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
 
 
 @inline
@@ -376,7 +382,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                     c[i, r] += S[k, r] * qdd_known[k]
         theta = inertia_rotated(oR[i], body[i, 15:25])
         force_cross(vel[i], momentum(theta, vel[i]), pA[i])
-        inertia_matrix(theta, IA[i])
+        inertia_matrix(theta, IA[i], False)  # the upper triangle (see pass 2)
         if fcode >= 0:
             wrench_to_aligned(fcode, oR[i], op[i], fext[i], t1)
             for r in range(6):
@@ -501,6 +507,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
 @core
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
     """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`)."""
+    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
     for s in range(lo, hi):
         status[s] = _hybrid_inlined(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
                                     F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)

@@ -79,7 +79,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         aligned_placement(i, ints[i, 0], liR, lip, oR, op, d)
         for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
             rotate6(oR[i], dofs[k], S[k])
-        inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i])
+        inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i], True)
         F[i, ints[i, 3]:, :] = 0.0  # only the columns >= k_i are used
     # Pass 2: articulated inertias and the bias forces of the unit joint forces;
     # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it
