@@ -13,38 +13,54 @@ from .spatial import rotation_from_quaternion
 
 
 @inline
-def body_placement(jtype, row, q, iq, R, p, Rj):
-    """Placement ``(R, p)`` of a body in its parent, ``X_tree * X_J(q)``, from the body's
-    kernel row (``Model._pack``); ``Rj`` is a 3 x 3 workspace.
+def _mix(row, j, c, s):
+    """``row[j] + c row[j + 9] + s row[j + 18]``: an entry of a revolute joint's rotation."""
+    return row[j] + c * row[j + 9] + s * row[j + 18]
 
-    Returns False when a free joint's quaternion is farther than ``QUAT_TOL`` from unit norm
-    (a near-unit quaternion is normalised).
-    """
+
+@inline
+def local_placement(jtype, row, q, iq, Rj):
+    """``(ok, R, p)``: the placement of a body in its parent, ``X_tree * X_J(q)``, from the
+    body's kernel row (``Model._pack``), as values: ``R`` a 9-tuple (row by row), ``p`` a
+    3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a free joint's quaternion is
+    farther than ``QUAT_TOL`` from unit norm (a near-unit quaternion is normalised)."""
+    P, J = ROW_XTREE_P, ROW_JOINT
     if jtype == REVOLUTE:
         s, c = sincos(q[iq])
-        for r in range(3):
-            p[r] = row[ROW_XTREE_P + r]
-            for k in range(3):
-                j = ROW_JOINT + 3 * r + k
-                R[r, k] = row[j] + c * row[j + 9] + s * row[j + 18]
-        return True
+        return (True, (_mix(row, J, c, s), _mix(row, J + 1, c, s), _mix(row, J + 2, c, s), _mix(row, J + 3, c, s),
+                       _mix(row, J + 4, c, s), _mix(row, J + 5, c, s), _mix(row, J + 6, c, s),
+                       _mix(row, J + 7, c, s), _mix(row, J + 8, c, s)),
+                (row[P], row[P + 1], row[P + 2]))
     if jtype == PRISMATIC:
         x = q[iq]
-        for r in range(3):
-            p[r] = row[ROW_XTREE_P + r] + row[ROW_JOINT + r] * x
-            for k in range(3):
-                R[r, k] = row[3 * r + k]
-        return True
+        return (True, (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8]),
+                (row[P] + row[J] * x, row[P + 1] + row[J + 1] * x, row[P + 2] + row[J + 2] * x))
     # FREE: X_tree * (rotation of the quaternion, position)
     n = np.sqrt(q[iq + 3] * q[iq + 3] + q[iq + 4] * q[iq + 4] + q[iq + 5] * q[iq + 5] + q[iq + 6] * q[iq + 6])
     if not abs(n - 1.0) <= QUAT_TOL:
-        return False
+        return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
     rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, Rj)
-    for r in range(3):
-        p[r] = row[9 + r] + row[3 * r] * q[iq] + row[3 * r + 1] * q[iq + 1] + row[3 * r + 2] * q[iq + 2]
-        for k in range(3):
-            R[r, k] = row[3 * r] * Rj[0, k] + row[3 * r + 1] * Rj[1, k] + row[3 * r + 2] * Rj[2, k]
-    return True
+    x, y, z = q[iq], q[iq + 1], q[iq + 2]
+    return (True, (row[0] * Rj[0, 0] + row[1] * Rj[1, 0] + row[2] * Rj[2, 0],
+                   row[0] * Rj[0, 1] + row[1] * Rj[1, 1] + row[2] * Rj[2, 1],
+                   row[0] * Rj[0, 2] + row[1] * Rj[1, 2] + row[2] * Rj[2, 2],
+                   row[3] * Rj[0, 0] + row[4] * Rj[1, 0] + row[5] * Rj[2, 0],
+                   row[3] * Rj[0, 1] + row[4] * Rj[1, 1] + row[5] * Rj[2, 1],
+                   row[3] * Rj[0, 2] + row[4] * Rj[1, 2] + row[5] * Rj[2, 2],
+                   row[6] * Rj[0, 0] + row[7] * Rj[1, 0] + row[8] * Rj[2, 0],
+                   row[6] * Rj[0, 1] + row[7] * Rj[1, 1] + row[8] * Rj[2, 1],
+                   row[6] * Rj[0, 2] + row[7] * Rj[1, 2] + row[8] * Rj[2, 2]),
+            (row[9] + row[0] * x + row[1] * y + row[2] * z, row[10] + row[3] * x + row[4] * y + row[5] * z,
+             row[11] + row[6] * x + row[7] * y + row[8] * z))
+
+
+@inline
+def body_placement(jtype, row, q, iq, R, p, Rj):
+    """:func:`local_placement` written into ``R`` (3, 3) and ``p`` (3,); returns its ``ok``."""
+    ok, Rv, pv = local_placement(jtype, row, q, iq, Rj)
+    R[0, 0], R[0, 1], R[0, 2], R[1, 0], R[1, 1], R[1, 2], R[2, 0], R[2, 1], R[2, 2] = Rv
+    p[0], p[1], p[2] = pv
+    return ok
 
 
 @inline

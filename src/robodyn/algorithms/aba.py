@@ -35,7 +35,7 @@ import numpy as np
 from numba import boolean, prange
 
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
-from ..joint_kernels import body_placement, friction_torque
+from ..joint_kernels import friction_torque, local_placement
 from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
                        momentum, motion_cross, rotate6, shift_motion, unshift_force, upper_triangle, wrench_to_aligned)
@@ -322,22 +322,27 @@ def finite_where(x, mask, value):
 
 
 @inline
-def aligned_placement(i, par, liR, lip, oR, op, d):
-    """World placement ``oR[i], op[i]`` of body ``i`` from its local one, and ``d[i]``, the
-    vector from the origin of its parent ``par`` (``-1``: the world) to its own, in world axes."""
+def aligned_placement(i, par, Rl, pl, oR, op, d):
+    """World placement ``oR[i], op[i]`` of body ``i`` from its local one ``(Rl, pl)`` (the
+    values of :func:`robodyn.joint_kernels.local_placement`), and ``d[i]``, the vector from
+    the origin of its parent ``par`` (``-1``: the world) to its own, in world axes."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = Rl
+    p0, p1, p2 = pl
     if par < 0:
-        for r in range(3):
-            d[i, r] = lip[i, r]
-            op[i, r] = lip[i, r]
-            for cc in range(3):
-                oR[i, r, cc] = liR[i, r, cc]
+        d[i, 0], d[i, 1], d[i, 2] = p0, p1, p2
+        op[i, 0], op[i, 1], op[i, 2] = p0, p1, p2
+        oR[i, 0, 0], oR[i, 0, 1], oR[i, 0, 2] = r00, r01, r02
+        oR[i, 1, 0], oR[i, 1, 1], oR[i, 1, 2] = r10, r11, r12
+        oR[i, 2, 0], oR[i, 2, 1], oR[i, 2, 2] = r20, r21, r22
         return
     Rp = oR[par]
     for r in range(3):
-        d[i, r] = Rp[r, 0] * lip[i, 0] + Rp[r, 1] * lip[i, 1] + Rp[r, 2] * lip[i, 2]
+        a0, a1, a2 = Rp[r, 0], Rp[r, 1], Rp[r, 2]
+        d[i, r] = a0 * p0 + a1 * p1 + a2 * p2
         op[i, r] = op[par, r] + d[i, r]
-        for cc in range(3):
-            oR[i, r, cc] = Rp[r, 0] * liR[i, 0, cc] + Rp[r, 1] * liR[i, 1, cc] + Rp[r, 2] * liR[i, 2, cc]
+        oR[i, r, 0] = a0 * r00 + a1 * r10 + a2 * r20
+        oR[i, r, 1] = a0 * r01 + a1 * r11 + a2 * r21
+        oR[i, r, 2] = a0 * r02 + a1 * r12 + a2 * r22
 
 
 def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
@@ -354,7 +359,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
     module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
     ``d[i]`` the shift from the parent's origin."""
-    (_, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2,
+    (_, (_, _, oR, op, Rj, _), vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2,
      _, _) = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == nv and qdd_known.shape[0] == nv
@@ -368,9 +373,10 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     # accelerations), rigid-body inertias and bias forces
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+        ok, Rl, pl = local_placement(ints[i, 1], body[i], q, ints[i, 2], Rj)
+        if not ok:
             return BAD_QUATERNION
-        aligned_placement(i, par, liR, lip, oR, op, d)
+        aligned_placement(i, par, Rl, pl, oR, op, d)
         if par >= 0:
             shift_motion(d[i], vel[par], vel[i])
         else:

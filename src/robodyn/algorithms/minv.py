@@ -32,7 +32,7 @@ import numpy as np
 from numba import prange
 
 from .._jit import core, kernel, parallel
-from ..joint_kernels import body_placement
+from ..joint_kernels import local_placement
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shift_motion, unshift_force,
                        upper_triangle)
 from . import _inputs
@@ -66,7 +66,7 @@ def workspace(nb, nv):
 def minv_one(ints, body, dofs, q, check, Minv, ws):
     """``Minv`` (nv, nv) at ``q``; returns a status (see ``_inputs``), ``i + 1`` when the
     articulated inertia of body ``i`` is singular."""
-    _, liR, lip, oR, op, d, Rj, IA, S, U, Dinv, F, UD, G, Ia, t1, t2 = ws
+    _, _, _, oR, op, d, Rj, IA, S, U, Dinv, F, UD, G, Ia, t1, t2 = ws
     nb, nv = ints.shape[0], dofs.shape[0]
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
@@ -74,9 +74,10 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         return NONFINITE
     # Pass 1: placements, motion subspaces S[k] and rigid-body inertias in world axes
     for i in range(nb):
-        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+        ok, Rl, pl = local_placement(ints[i, 1], body[i], q, ints[i, 2], Rj)
+        if not ok:
             return BAD_QUATERNION
-        aligned_placement(i, ints[i, 0], liR, lip, oR, op, d)
+        aligned_placement(i, ints[i, 0], Rl, pl, oR, op, d)
         for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
             rotate6(oR[i], dofs[k], S[k])
         inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i], True)
