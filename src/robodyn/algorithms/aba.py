@@ -512,7 +512,8 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
 
 @core
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
-    """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`)."""
+    """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`).
+    The views of ``ws`` are rebuilt here, so that the compiler sees their shapes."""
     ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
     for s in range(lo, hi):
         status[s] = _hybrid_inlined(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
