@@ -93,7 +93,10 @@ def test_out_receives_the_result_and_is_returned(model, name, size):
     assert_rel(out, expected, 0.0, f"{name} into out")
     listed = call(model, q.tolist(), v.tolist(), a.tolist(), out=out)  # the general path
     assert listed is out
-    assert_rel(out, expected, 0.0, f"{name} into out, list inputs")
+    # separately compiled code: whether the compiler inlines the shared per-state function
+    # into it depends on which process compiled what first (the on-disk cache), which may
+    # change the last bit
+    assert_rel(out, expected, 1e-15, f"{name} into out, list inputs")
 
 
 @pytest.mark.parametrize("name", list(OUT_CALLS))

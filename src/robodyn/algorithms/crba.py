@@ -24,15 +24,20 @@ from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
 from .kinematics import poses_checked, world_motion_subspace
 
 
-@kernel
-def workspace(nb, nv):
-    """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
-    buf = np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6)
+@inline
+def workspace_views(buf, nb, nv):
+    """The scratch arrays of :func:`crba_state` carved from ``buf`` (see :func:`workspace`)."""
     P, o = poses(buf, 0, nb)
     oS, o = take(buf, o, (nv, 6))
     Ic, o = take(buf, o, (nb, 10))
     F, o = take(buf, o, (6,))
-    return buf, P, oS, Ic, F
+    return (buf, P, oS, Ic, F)
+
+
+@kernel
+def workspace(nb, nv):
+    """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
+    return workspace_views(np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6), nb, nv)
 
 
 @inline
@@ -42,8 +47,10 @@ def world_inertias(ints, body, oR, op, Ic):
         inertia_act(oR[i], op[i], body[i, 15:25], Ic[i])
 
 
-@core
-def crba_one(ints, body, dofs, q, check, M, ws):
+@inline
+def crba_state(ints, body, dofs, q, check, M, ws):
+    """``M`` (nv, nv) at ``q``; returns a status (see ``_inputs``). Inlined into
+    :func:`crba_one` (one state) and :func:`crba_range` (the batch loop)."""
     _, (liR, lip, oR, op, Rj, pj), oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
@@ -71,13 +78,27 @@ def crba_one(ints, body, dofs, q, check, M, ws):
     return result_status(check, finite2(M))
 
 
+@core
+def crba_one(ints, body, dofs, q, check, M, ws):
+    """:func:`crba_state` of one state (the compiled function other kernels call)."""
+    return crba_state(ints, body, dofs, q, check, M, ws)
+
+
+@core
+def crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws):
+    """:func:`crba_state` of the states ``lo <= s < hi`` of a batch. The views of ``ws`` are
+    rebuilt here, so that the compiler sees their shapes."""
+    ws = workspace_views(ws[0], ints.shape[0], dofs.shape[0])
+    for s in range(lo, hi):
+        status[s] = crba_state(ints, body, dofs, Q[s], check, MM[s], ws)
+
+
 @parallel
 def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
     B = Q.shape[0]
     for c in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = crba_one(ints, body, dofs, Q[s], check, MM[s], ws)
+        crba_range(ints, body, dofs, Q, check, MM, status, c * B // nchunk, (c + 1) * B // nchunk,
+                   workspace(ints.shape[0], dofs.shape[0]))
 
 
 @kernel
