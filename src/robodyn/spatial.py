@@ -131,14 +131,18 @@ def rotate6(R, x, out):
 
 
 @inline
-def shift_motion(d, m, out):
+def shifted_motion(d, m):
     """A motion vector at a point moved to the point ``d`` from it, axes unchanged:
-    ``[v - d x w; w]`` (:func:`motion_act_inv` with ``R = 1``)."""
+    ``[v - d x w; w]`` (:func:`motion_act_inv` with ``R = 1``), as a tuple of 6."""
     w0, w1, w2 = m[3], m[4], m[5]
-    out[0] = m[0] - (d[1] * w2 - d[2] * w1)
-    out[1] = m[1] - (d[2] * w0 - d[0] * w2)
-    out[2] = m[2] - (d[0] * w1 - d[1] * w0)
-    out[3], out[4], out[5] = w0, w1, w2
+    return (m[0] - (d[1] * w2 - d[2] * w1), m[1] - (d[2] * w0 - d[0] * w2), m[2] - (d[0] * w1 - d[1] * w0),
+            w0, w1, w2)
+
+
+@inline
+def shift_motion(d, m, out):
+    """``out =`` :func:`shifted_motion` ``(d, m)``."""
+    out[0], out[1], out[2], out[3], out[4], out[5] = shifted_motion(d, m)
 
 
 @inline

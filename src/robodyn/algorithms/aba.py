@@ -38,7 +38,8 @@ from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, pa
 from ..joint_kernels import friction_torque, local_placement
 from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
-                       momentum, motion_cross, rotate6, shift_motion, unshift_force, upper_triangle, wrench_to_aligned)
+                       momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
+                       wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
@@ -279,27 +280,29 @@ def single_dof_articulated(IA_i, U_k, dinv):
 
 
 @inline
-def joint_motion(i, iv, n, axis, R, dofs, v, S, vJ, vel_i, c_i):
-    """Motion subspace ``S[k]`` of body ``i`` in world axes (``R`` its world rotation), the
-    joint velocity ``vJ = S qd`` added to ``vel_i``, and ``c_i = vel_i x vJ``. ``axis`` >= 0
-    when the joint's ``S`` is the unit motion ``e_axis`` (see ``Model._pack``): then ``S``
-    is a column of ``R`` in one half and zero in the other."""
+def joint_motion(iv, n, axis, R, dofs, v, S, vJ, vp, vel_i, c_i):
+    """Motion subspace ``S[k]`` of a body's joint in world axes (``R`` the body's world
+    rotation), its velocity ``vel_i = vp + vJ`` (``vp``: the parent's velocity at the body's
+    origin, as values; ``vJ = S qd``) and ``c_i = vel_i x vJ``. ``axis`` >= 0 when the
+    joint's ``S`` is the unit motion ``e_axis`` (see ``Model._pack``): then ``S`` is a column
+    of ``R`` in one half and zero in the other, and nothing goes through ``vJ``."""
+    v0, v1, v2, v3, v4, v5 = vp
     if axis >= 0:
         lo = 0 if axis < 3 else 3
         col, qd = axis - lo, v[iv]
-        for r in range(6):
-            S[iv, r] = 0.0
-            vJ[r] = 0.0
-        for r in range(3):
-            S[iv, lo + r] = R[r, col]
-            vJ[lo + r] = R[r, col] * qd
-            vel_i[lo + r] += vJ[lo + r]
+        x0, x1, x2 = R[0, col], R[1, col], R[2, col]
+        j0, j1, j2 = x0 * qd, x1 * qd, x2 * qd
         if lo == 3:  # vel x [0; w] = [v x w; omega x w]
-            cross_into(vel_i[0], vel_i[1], vel_i[2], vJ[3], vJ[4], vJ[5], c_i, 0)
-            cross_into(vel_i[3], vel_i[4], vel_i[5], vJ[3], vJ[4], vJ[5], c_i, 3)
+            S[iv, 0], S[iv, 1], S[iv, 2], S[iv, 3], S[iv, 4], S[iv, 5] = 0.0, 0.0, 0.0, x0, x1, x2
+            v3, v4, v5 = v3 + j0, v4 + j1, v5 + j2
+            cross_into(v0, v1, v2, j0, j1, j2, c_i, 0)
+            cross_into(v3, v4, v5, j0, j1, j2, c_i, 3)
         else:  # vel x [v; 0] = [omega x v; 0]
-            cross_into(vel_i[3], vel_i[4], vel_i[5], vJ[0], vJ[1], vJ[2], c_i, 0)
+            S[iv, 0], S[iv, 1], S[iv, 2], S[iv, 3], S[iv, 4], S[iv, 5] = x0, x1, x2, 0.0, 0.0, 0.0
+            v0, v1, v2 = v0 + j0, v1 + j1, v2 + j2
+            cross_into(v3, v4, v5, j0, j1, j2, c_i, 0)
             c_i[3], c_i[4], c_i[5] = 0.0, 0.0, 0.0
+        vel_i[0], vel_i[1], vel_i[2], vel_i[3], vel_i[4], vel_i[5] = v0, v1, v2, v3, v4, v5
         return
     for r in range(6):
         vJ[r] = 0.0
@@ -307,8 +310,8 @@ def joint_motion(i, iv, n, axis, R, dofs, v, S, vJ, vel_i, c_i):
         rotate6(R, dofs[k], S[k])
         for r in range(6):
             vJ[r] += S[k, r] * v[k]
-    for r in range(6):
-        vel_i[r] += vJ[r]
+    vel_i[0], vel_i[1], vel_i[2] = v0 + vJ[0], v1 + vJ[1], v2 + vJ[2]
+    vel_i[3], vel_i[4], vel_i[5] = v3 + vJ[3], v4 + vJ[4], v5 + vJ[5]
     motion_cross(vel_i, vJ, c_i)
 
 
@@ -377,11 +380,8 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
         if not ok:
             return BAD_QUATERNION
         aligned_placement(i, par, Rl, pl, oR, op, d)
-        if par >= 0:
-            shift_motion(d[i], vel[par], vel[i])
-        else:
-            vel[i, :] = 0.0
-        joint_motion(i, iv, n, ints[i, 5], oR[i], dofs, v, S, t1, vel[i], c[i])
+        vp = shifted_motion(d[i], vel[par]) if par >= 0 else (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+        joint_motion(iv, n, ints[i, 5], oR[i], dofs, v, S, t1, vp, vel[i], c[i])
         if known[iv]:
             for k in range(iv, iv + n):
                 for r in range(6):
