@@ -404,7 +404,8 @@ def congruence_shift(d, a, out, lower):
     triangle ``a`` (:func:`upper_triangle`), and ``X`` the shift by ``d``
     (:func:`congruence_to_parent` with ``R = 1``). With ``P = [d]x``:
     ``X^T A X = [[A11, C], [C^T, A22 + (P A12)^T + P C]]``, ``C = A12 - A11 P``.
-    Only the upper triangle of ``out`` is updated unless ``lower`` is True.
+    Only the upper triangle of ``out`` is updated; with ``lower`` True its lower triangle is
+    then copied from the upper one (so ``out`` reads as the full symmetric sum).
 
     Taking ``A`` as values lets a caller pass one it computes without storing it (the ABA's
     ``IA_i - U_i D_i^-1 U_i^T``)."""
