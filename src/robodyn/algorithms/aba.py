@@ -68,7 +68,7 @@ def workspace_views(buf, nb, nv):
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    return P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau
+    return (buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau)
 
 
 @kernel
@@ -77,7 +77,7 @@ def workspace(nb, nv):
     Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
     of the joint forces and ``known`` is all False (no joint of known acceleration)."""
     buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
-    return (buf,) + workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
+    return workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
 
 
 @inline
@@ -514,7 +514,7 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
     """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`).
     The views of ``ws`` are rebuilt here, so that the compiler sees their shapes."""
-    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
+    ws = workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
     for s in range(lo, hi):
         status[s] = _hybrid_inlined(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
                                     F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
