@@ -17,7 +17,6 @@ returns NaN or Inf from finite inputs: it raises instead.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from .._jit import inline
@@ -232,11 +231,6 @@ def output(out, batch: tuple, tail: tuple, inputs: dict) -> tuple[np.ndarray, np
         if np.may_share_memory(out, a):
             raise ValueError(f"out: shares memory with the input {name}")
     return out.reshape(flat), out
-
-
-def chunks(B: int) -> int:
-    """Number of parallel chunks for a batch of ``B`` states."""
-    return max(1, min(B, numba.get_num_threads()))
 
 
 def as_batch(a: np.ndarray) -> np.ndarray:

@@ -43,6 +43,7 @@ from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._schedule import chunks, claim
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -522,10 +523,13 @@ def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, l
 
 @parallel
 def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
-        aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, c * B // nchunk,
-                  (c + 1) * B // nchunk, workspace(ints.shape[0], dofs.shape[0]))
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -577,7 +581,7 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
         B = x["q"].shape[0]
         status = np.empty(B, dtype=np.int64)
         _aba_batch(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd, status,
-                   _inputs.chunks(B))
+                   chunks(B))
     bad = _inputs.raise_for_status(model, status, x, "aba")
     if bad:
         i = bad - 1

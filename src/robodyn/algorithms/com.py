@@ -18,6 +18,7 @@ from . import _inputs
 from .crba import world_inertias
 from ._inputs import OK, finite, finite2, result_status
 from .kinematics import poses_checked, world_motion_subspace
+from ._schedule import chunks, claim
 
 
 @kernel
@@ -64,11 +65,14 @@ def com_one(ints, body, dofs, q, check, c, Jc, ws):
 
 @parallel
 def _com_batch(ints, body, dofs, Q, check, C, JC, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -88,7 +92,7 @@ def _run(model, q, check_finite, with_jacobian, what):
     if batch == ():  # one state: no parallel launch
         status[0] = _com_single(k["ints"], k["body"], k["dofs"][(False, False)], Q[0], check_finite, C[0], JC[0])
     else:
-        _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, _inputs.chunks(B))
+        _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return batch, C, JC
 

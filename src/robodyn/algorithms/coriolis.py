@@ -31,6 +31,7 @@ from .crba import world_inertias
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
 from .kinematics import poses_checked, world_motion_subspace
+from ._schedule import chunks, claim
 
 
 @kernel
@@ -130,11 +131,14 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
 
 @parallel
 def _coriolis_batch(ints, body, dofs, Q, V, check, CC, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -159,7 +163,7 @@ def _run(model, batch, x, check, what, out=None):
         status = _coriolis_single(k["ints"], k["body"], dofs, q, v, check, C)
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
-        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, _inputs.chunks(q.shape[0]))
+        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x, what)
     return C, result
 

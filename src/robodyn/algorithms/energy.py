@@ -18,6 +18,7 @@ from . import _inputs
 from ._inputs import OK, finite, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
+from ._schedule import chunks, claim
 
 
 @core
@@ -45,11 +46,14 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
 
 @parallel
 def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = motion_workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -69,7 +73,7 @@ def _run(model, check_finite, what, **arrays):
                                    check_finite, OUT[0])
     else:
         _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,
-                      _inputs.chunks(B))
+                      chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return batch, OUT
 

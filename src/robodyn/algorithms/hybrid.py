@@ -31,16 +31,20 @@ from .. import joints as J
 from . import _inputs
 from ._inputs import OK
 from .aba import hybrid_one, workspace
+from ._schedule import chunks, claim
 
 
 @parallel
 def _hybrid_batch(ints, body, dofs, params, Q, V, A, T, known, F, fcode, check, QDD, TAU, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = hybrid_one(ints, body, dofs, params, Q[s], V[s], A[s], T[s], known,
-                                   F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], TAU[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = hybrid_one(ints, body, dofs, params, Q[s], V[s], A[s], T[s], known,
+                                       F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], TAU[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -117,7 +121,7 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     else:
         B = x["q"].shape[0]
         a, tau, status = np.empty((B, model.nv)), np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
-        _hybrid_batch(*args, a, tau, status, _inputs.chunks(B))
+        _hybrid_batch(*args, a, tau, status, chunks(B))
     if np.any(status):
         report = {"q": x["q"], "v": x["v"], "a_known": np.where(known, x["a_known"], 0.0),
                   "tau_known": np.where(known, 0.0, x["tau_known"])}

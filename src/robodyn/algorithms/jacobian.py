@@ -25,6 +25,7 @@ from . import _inputs
 from ._inputs import OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
+from ._schedule import chunks, claim
 
 FRAMES = ("world", "local", "local_world_aligned")
 
@@ -57,12 +58,15 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
 
 @parallel
 def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = motion_workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s],
-                                     OP[s], ACC[s], VEL[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s],
+                                         OP[s], ACC[s], VEL[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -84,7 +88,7 @@ def _run(model, x, b, check, what):
                                      OR[0], OP[0], ACC[0], VEL[0])
     else:
         _jacobian_batch(k["ints"], k["body"], k["dofs"][(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL,
-                        status, _inputs.chunks(B))
+                        status, chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return JJ, OR, OP, ACC, VEL
 

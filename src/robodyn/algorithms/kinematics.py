@@ -18,6 +18,7 @@ from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
+from ._schedule import chunks, claim
 
 
 @inline
@@ -99,11 +100,14 @@ def _fk_single(ints, body, q, oR, op, check):
 
 @parallel
 def _fk_batch(ints, body, Q, OR, OP, check, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         liR, lip, Rj, pj = workspace(ints.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
+            lo, hi = claim(counter, B, nchunk)
 
 
 def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -116,7 +120,7 @@ def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> t
     else:
         B = q.shape[0]
         oR, op, status = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3)), np.empty(B, dtype=np.int64)
-        _fk_batch(ints, body, q, oR, op, check, status, _inputs.chunks(B))
+        _fk_batch(ints, body, q, oR, op, check, status, chunks(B))
     _inputs.raise_for_status(model, status, {"q": q}, what)
     return oR, op
 

@@ -39,6 +39,7 @@ from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from .aba import aligned_placement, articulated_inertia, joint_inertia
+from ._schedule import chunks, claim
 
 
 @kernel
@@ -136,11 +137,14 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
 
 @parallel
 def _minv_batch(ints, body, dofs, Q, check, MM, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -173,7 +177,7 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
     else:
         B = q.shape[0]
         Minv, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
-        _minv_batch(k["ints"], k["body"], dofs, q, check_finite, Minv, status, _inputs.chunks(B))
+        _minv_batch(k["ints"], k["body"], dofs, q, check_finite, Minv, status, chunks(B))
     bad = _inputs.raise_for_status(model, status, x, "inverse_mass_matrix")
     if bad:
         i = bad - 1

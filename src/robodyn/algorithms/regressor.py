@@ -49,6 +49,7 @@ from . import _inputs
 from ._inputs import NONFINITE, OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass
+from ._schedule import chunks, claim
 
 EXTRA_COLUMNS = ("viscous", "coulomb", "armature", "offset")
 
@@ -134,11 +135,14 @@ def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
 
 @parallel
 def _regressor_batch(ints, body, dofs, params, Q, V, A, check, Y, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -232,11 +236,14 @@ def slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y,
 
 @parallel
 def _slotine_li_batch(ints, body, dofs, params, Q, V, VR, AR, check, Y, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = reference_workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = slotine_li_regressor_one(ints, body, dofs, params, Q[s], V[s], VR[s], AR[s], check, Y[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = slotine_li_regressor_one(ints, body, dofs, params, Q[s], V[s], VR[s], AR[s], check, Y[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -273,12 +280,15 @@ def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
 
 @parallel
 def _energy_regressor_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
         ws = workspace(ints.shape[0], dofs.shape[0])
-        for s in range(c * B // nchunk, (c + 1) * B // nchunk):
-            status[s] = energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check,
-                                             OUT[s], ws)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check,
+                                                 OUT[s], ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -359,7 +369,7 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
                                       check_finite, Y[0])
     else:
         _regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], params, Q, V, A, check_finite, Y, status,
-                         _inputs.chunks(B))
+                         chunks(B))
     _inputs.raise_for_status(model, status, x, "regressor")
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
@@ -413,7 +423,7 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, co
     else:
         B = x["q"].shape[0]
         Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
-        _slotine_li_batch(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y, status, _inputs.chunks(B))
+        _slotine_li_batch(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y, status, chunks(B))
     _inputs.raise_for_status(model, status, x, "slotine_li_regressor")
     return _inputs.unflatten(Y, batch)
 
@@ -429,7 +439,7 @@ def _energy(model, check_finite, what, **arrays):
     if B == 1:  # one state: no thread start-up of the batch driver
         status[0] = _energy_regressor_single(*args, Q[0], V[0], check_finite, OUT[0])
     else:
-        _energy_regressor_batch(*args, Q, V, check_finite, OUT, status, _inputs.chunks(B))
+        _energy_regressor_batch(*args, Q, V, check_finite, OUT, status, chunks(B))
     _inputs.raise_for_status(model, status, x, what)
     return OUT.reshape(batch + OUT.shape[1:])
 

@@ -27,6 +27,7 @@ from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
 from .kinematics import world_placement
+from ._schedule import chunks, claim
 
 
 @inline
@@ -177,10 +178,13 @@ def rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, 
 
 @parallel
 def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
-        rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, c * B // nchunk,
-                   (c + 1) * B // nchunk, workspace(ints.shape[0]))
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
+        ws = workspace(ints.shape[0])
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, lo, hi, ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -208,7 +212,7 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
         _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status,
-                    _inputs.chunks(q.shape[0]))
+                    chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x if report is None else report, what)
     return result
 
