@@ -10,7 +10,7 @@ their callers.
 
 ``fast(*argtypes)``: a single-state entry point compiled for exactly one argument signature
 (C-contiguous float64 arrays ``VEC``/``MAT`` for the state and the output, the model's
-read-only ``MODEL_INTS``/``MODEL_PACKED`` arrays, a ``bool``). Compilation happens (or the
+``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``Model._pack``), a ``bool``). Compilation happens (or the
 cache is loaded) when the module defining it is imported, and the dispatcher compiles nothing
 else: any other argument types (lists, integers, strided or read-only arrays, batches) raise
 ``TypeError``, on which the public function takes its general path.
@@ -38,8 +38,8 @@ exact = njit(_nrt=False, **{**_BASE, "fastmath": {"contract"}})
 
 VEC = _types.Array(_types.float64, 1, "C")
 MAT = _types.Array(_types.float64, 2, "C")
-MODEL_INTS = _types.Array(_types.int64, 2, "C", readonly=True)
-MODEL_PACKED = _types.Array(_types.float64, 1, "C", readonly=True)
+MODEL_INTS = _types.Array(_types.int64, 2, "C")
+MODEL_PACKED = _types.Array(_types.float64, 1, "C")
 
 
 def fast(*argtypes):

@@ -19,10 +19,12 @@ from .._jit import inline
 
 
 @intrinsic
-def _view(typingctx, buf, offset, shape):
-    """The C-contiguous array of ``shape`` (a tuple of ints) starting at ``buf[offset]``,
-    sharing ``buf``'s memory and owning none (like ``carray``, and usable in the kernels
-    compiled without reference counting)."""
+def view(typingctx, buf, offset, shape):
+    """The C-contiguous array of ``shape`` (a tuple of ints) starting at the flat index
+    ``offset`` of the C-contiguous array ``buf``, sharing ``buf``'s memory and owning none
+    (like ``carray``, and usable in the kernels compiled without reference counting)."""
+    if not (isinstance(buf, types.Array) and buf.layout == "C"):
+        return None
     ndim = len(shape)
     arrty = types.Array(buf.dtype, ndim, "C")
     sig = arrty(buf, offset, shape)
@@ -53,7 +55,7 @@ def take(buf, o, shape):
         n *= s
     if o + n > buf.shape[0]:  # a layout error in the caller: fail loudly, never overrun
         raise IndexError("workspace buffer too small")
-    return _view(buf, o, shape), o + n
+    return view(buf, o, shape), o + n
 
 
 POSES_SIZE_NB, POSES_SIZE = 24, 12  # entries of :func:`poses`: 24 nb + 12

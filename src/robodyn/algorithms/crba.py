@@ -19,8 +19,9 @@ from numba import boolean, prange
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
-from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
+from ._inputs import OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._schedule import chunks, claim
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -75,7 +76,7 @@ def crba_state(ints, body, dofs, q, check, M, ws):
         if par >= 0:
             for r in range(10):
                 Ic[par, r] += Ic[i, r]
-    return result_status(check, finite2(M))
+    return result_status(check, finite(view(M, 0, (M.size,))))
 
 
 @core
@@ -95,10 +96,13 @@ def crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws):
 
 @parallel
 def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
-    B = Q.shape[0]
-    for c in prange(nchunk):
-        crba_range(ints, body, dofs, Q, check, MM, status, c * B // nchunk, (c + 1) * B // nchunk,
-                   workspace(ints.shape[0], dofs.shape[0]))
+    B, counter = Q.shape[0], np.zeros(1, np.int64)
+    for _ in prange(nchunk):
+        ws = workspace(ints.shape[0], dofs.shape[0])
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws)
+            lo, hi = claim(counter, B, nchunk)
 
 
 @kernel
@@ -138,6 +142,6 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
         status = _crba_single(k["ints"], k["body"], dofs, q, check_finite, M)
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
-        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, _inputs.chunks(q.shape[0]))
+        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, chunks(q.shape[0]))
     _inputs.raise_for_status(model, status, x, "crba")
     return result
