@@ -2,9 +2,10 @@
 
 import numpy as np
 import pytest
+import numba
 from numba import njit
 
-from robodyn.algorithms._schedule import chunks, claim
+from robodyn.algorithms._schedule import MIN_CHUNK, chunks, claim
 
 
 @njit
@@ -20,6 +21,7 @@ def _claimed(B, nchunk):
 def test_claims_cover_every_state_once(B):
     nchunk = chunks(B)
     assert 1 <= nchunk <= B
+    assert nchunk <= max(numba.get_num_threads(), -(-B // MIN_CHUNK))  # chunks of a small batch stay large
     bounds, count = _claimed(B, nchunk)
     assert count == nchunk + 3
     lo, hi = bounds[:nchunk, 0], bounds[:nchunk, 1]

@@ -10,9 +10,9 @@ their callers.
 
 ``fast(*argtypes)``: a single-state entry point compiled for exactly one argument signature
 (C-contiguous float64 arrays ``VEC``/``MAT`` for the state and the output, the model's
-``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``Model._pack``), a ``bool``). Compilation happens (or the
-cache is loaded) when the module defining it is imported, and the dispatcher compiles nothing
-else: any other argument types (lists, integers, strided or read-only arrays, batches) raise
+``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``Model._pack``), a ``bool``).
+Compilation happens (or the cache is loaded) when the module defining it is imported, and the
+dispatcher compiles nothing else: any other argument types (lists, integers, strided or read-only arrays, batches) raise
 ``TypeError``, on which the public function takes its general path.
 
 All release the GIL (``nogil``), so Python threads run them concurrently (they share no

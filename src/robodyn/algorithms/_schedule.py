@@ -30,12 +30,15 @@ from numba.extending import intrinsic
 from .._jit import inline
 
 CHUNKS_PER_THREAD = 32
+MIN_CHUNK = 64  # states: each worker allocates a workspace, so chunks of a small batch stay large
 
 
 def chunks(B: int) -> int:
-    """Number of chunks of a batch of ``B`` states (``CHUNKS_PER_THREAD`` per thread, at most
-    one per state)."""
-    return max(1, min(B, CHUNKS_PER_THREAD * numba.get_num_threads()))
+    """Number of chunks of a batch of ``B`` states: ``CHUNKS_PER_THREAD`` per thread for a
+    large batch, fewer so that a chunk has at least ``MIN_CHUNK`` states, and at least one per
+    thread (at most one per state)."""
+    threads = numba.get_num_threads()
+    return max(1, min(B, threads), min(-(-B // MIN_CHUNK), CHUNKS_PER_THREAD * threads))
 
 
 @intrinsic
