@@ -129,6 +129,32 @@ def test_unusable_out_is_refused_and_left_alone(name):
         np.testing.assert_equal(a, random_state(model, np.random.default_rng(5), (2,))[2])
 
 
+@pytest.mark.parametrize("name", list(OUT_CALLS))
+def test_single_state_out_is_checked_by_the_fast_kernels(name):
+    """For one state the compiled fast path checks ``out`` itself: the same number of entries
+    in another shape, or an input that overlaps it by one entry, sends the call to the general
+    path, which raises; ``out`` is not written."""
+    model = MODELS[0]
+    call = OUT_CALLS[name]
+    state = random_state(model, np.random.default_rng(6))
+    shape = call(model, *state).shape
+    wrong = np.full((3, model.nv ** 2 // 3) if len(shape) == 2 else (model.nv - 1,), np.nan)
+    with pytest.raises(ValueError, match=r"out: expected shape"):
+        call(model, *state, out=wrong)
+    assert np.isnan(wrong).all()
+    size = int(np.prod(shape))
+    read = {"crba": 1, "coriolis_matrix": 2}.get(name, 3)  # the inputs the call reads: q, v, a
+    for k in range(read):
+        buffer = np.zeros(size + state[k].size)
+        out = buffer[:size].reshape(shape)
+        x = buffer[size - 1:size - 1 + state[k].size]  # its first entry is out's last
+        x[:] = state[k]
+        before = buffer.copy()
+        with pytest.raises(ValueError, match=r"out: shares memory with the input"):
+            call(model, *(x if j == k else s for j, s in enumerate(state)), out=out)
+        np.testing.assert_equal(buffer, before)
+
+
 @numba.njit
 def _carve(n_buffer, rows):
     buf = np.empty(n_buffer)

@@ -194,17 +194,29 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
     return f, codes[frame]
 
 
-def fast_out(out, shape: tuple, *inputs):
-    """The output array of a single-state fast path: a new ``np.empty(shape)`` when ``out`` is
-    None, ``out`` itself when :func:`output` accepts it for one state of result shape ``shape``,
-    else None (the caller then takes its general path, which knows the batch shape and raises
-    :func:`output`'s error if ``out`` does not fit it either)."""
-    if out is None:
-        return np.empty(shape)
-    try:
-        return output(out, (), shape, dict(enumerate(inputs)))[1]
-    except ValueError:
-        return None
+def fast_out(out, shape: tuple):
+    """The output array of a single-state fast path: ``out`` itself, or a new
+    ``np.empty(shape)`` when it is None. The fast kernels are compiled for a C-contiguous,
+    writeable float64 ``out`` only (anything else raises ``TypeError`` in the dispatcher) and
+    check its shape and that it overlaps no input (:func:`fits`) before they write; when it
+    does not fit, the caller takes its general path, where :func:`output` raises the error
+    that says why."""
+    return np.empty(shape) if out is None else out
+
+
+@inline
+def apart(out, x):
+    """True when the arrays ``out`` and ``x`` occupy disjoint memory (the bounds test of
+    ``np.may_share_memory``): the kernels read their inputs while they write ``out``."""
+    o, b = out.ctypes.data, x.ctypes.data
+    return o + out.nbytes <= b or b + x.nbytes <= o
+
+
+@inline
+def fits(out, n, x, y, z):
+    """The single-state output check of a fast path: ``out`` is (n,) or (n, n) and shares no
+    memory with the inputs ``x, y, z`` (pass an input again where there are fewer)."""
+    return out.shape[0] == n and out.size == n ** out.ndim and apart(out, x) and apart(out, y) and apart(out, z)
 
 
 def output(out, batch: tuple, tail: tuple, inputs: dict) -> tuple[np.ndarray, np.ndarray]:

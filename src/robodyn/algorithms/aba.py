@@ -42,7 +42,7 @@ from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix
                        wrench_to_aligned)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
 from ._schedule import chunks, claim
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
@@ -542,6 +542,8 @@ def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
 def _aba_packed(ints, packed, q, v, tau, check, qdd):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
+    if not fits(qdd, dofs.shape[0], q, v, tau):
+        return WRONG_SIZE
     return aba_one(ints, body, dofs, params, q, v, tau, zero, NO_WRENCH, check, qdd,
                    workspace(ints.shape[0], dofs.shape[0]))
 
@@ -564,12 +566,11 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     """
     k = model._kernel
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
-        qdd = _inputs.fast_out(out, (model.nv,), q, v, tau)  # fast path for one state: the kernel checks
+        qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
-            if qdd is not None and _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite,
-                                               qdd) == OK:
+            if _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite, qdd) == OK:
                 return qdd
-        except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
+        except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)

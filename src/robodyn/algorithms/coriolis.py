@@ -29,7 +29,7 @@ from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion
 from . import _inputs
 from .crba import world_inertias
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import OK, WRONG_SIZE, finite2, nq_of, result_status, unpack
+from ._inputs import OK, WRONG_SIZE, finite2, fits, nq_of, result_status, unpack
 from .kinematics import poses_checked, world_motion_subspace
 from ._schedule import chunks, claim
 
@@ -150,6 +150,8 @@ def _coriolis_single(ints, body, dofs, q, v, check, C):
 def _coriolis_packed(ints, packed, q, v, check, C):
     """One state, the model in one array (the fast path)."""
     body, dofs, _, _ = unpack(ints, packed)
+    if not fits(C, dofs.shape[0], q, v, v):
+        return WRONG_SIZE
     return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 
 
@@ -178,11 +180,11 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray |
     and Wensing (2021).
     """
     k = model._kernel  # fast path for one state: the kernel checks sizes and values
-    C = _inputs.fast_out(out, (model.nv, model.nv), q, v)
+    C = _inputs.fast_out(out, (model.nv, model.nv))
     try:
-        if C is not None and _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
+        if _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
             return C
-    except TypeError:  # not contiguous float64 vectors
+    except TypeError:  # not contiguous float64 arrays
         pass
     batch, x = _inputs.states(model, q=q, v=v)
     return _run(model, batch, x, check_finite, "coriolis_matrix", out)[1]

@@ -20,7 +20,7 @@ from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kerne
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._inputs import OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
 from ._schedule import chunks, claim
 from .kinematics import poses_checked, world_motion_subspace
 
@@ -114,6 +114,8 @@ def _crba_single(ints, body, dofs, q, check, M):
 def _crba_packed(ints, packed, q, check, M):
     """One state, the model in one array (the fast path)."""
     body, dofs, _, _ = unpack(ints, packed)
+    if not fits(M, dofs.shape[0], q, q, q):
+        return WRONG_SIZE
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
@@ -129,11 +131,11 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
     k = model._kernel
-    M = _inputs.fast_out(out, (model.nv, model.nv), q)  # fast path for one state: the kernel checks q
+    M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
-        if M is not None and _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
+        if _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
             return M
-    except (TypeError, KeyError):  # not a contiguous float64 vector (or armature not bool)
+    except (TypeError, KeyError):  # not contiguous float64 arrays (or armature not bool)
         pass
     batch, x = _inputs.states(model, q=q)
     dofs, q = k["dofs"][(False, bool(armature))], x["q"]

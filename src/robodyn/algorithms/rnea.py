@@ -25,7 +25,7 @@ from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act
                        wrench_to_local)
 from . import _inputs
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, nq_of, result_status, unpack
+from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
 from .kinematics import world_placement
 from ._schedule import chunks, claim
 
@@ -196,6 +196,8 @@ def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
 def _rnea_packed(ints, packed, q, v, a, check, tau):
     """One state without external wrenches, the model in one array (the fast path)."""
     body, dofs, params, zero = unpack(ints, packed)
+    if not fits(tau, dofs.shape[0], q, v, a):
+        return WRONG_SIZE
     return rnea_one(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
@@ -245,12 +247,11 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     """
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
         k = model._kernel  # fast path for one state: the kernel checks sizes and values
-        tau = _inputs.fast_out(out, (model.nv,), q, v, a)
+        tau = _inputs.fast_out(out, (model.nv,))
         try:
-            if tau is not None and _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite,
-                                                tau) == OK:
+            if _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
-        except (TypeError, KeyError):  # not contiguous float64 vectors (or options not bool)
+        except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
