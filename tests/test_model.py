@@ -188,6 +188,32 @@ def test_loaded_models_have_parent_before_child(model):
     assert all(model.parent[i] < i for i in range(model.nbodies))
 
 
+@pytest.mark.parametrize("seed", range(6))
+def test_kernel_table_holds_the_end_of_each_subtree(seed):
+    """``ints[i, 6]`` bounds the dofs of body ``i``'s subtree: every one of them lies in
+    ``idx_v[i] <= k < end``, and ``end`` is the end of one of them (so, numbered depth first
+    as the builder numbers them, the range holds exactly the subtree's dofs)."""
+    from robodyn.random import random_model
+
+    depth_first = small_tree_builder().build()
+    for m in (random_model(9, seed=seed, floating_base=bool(seed % 2), branching=0.5), depth_first):
+        ints = m._kernel["ints"]
+        for i in range(m.nbodies):
+            subtree = [j for j in range(m.nbodies) if i in _ancestors_and_self(m.parent, j)]
+            ends = [m.idx_v[j] + ints[j, 4] for j in subtree]
+            assert all(m.idx_v[j] >= m.idx_v[i] for j in subtree)
+            assert ints[i, 6] == max(ends), (m.name, i)
+            if m is depth_first:
+                assert ints[i, 6] - m.idx_v[i] == sum(ints[j, 4] for j in subtree)
+
+
+def _ancestors_and_self(parent, j):
+    chain = [j]
+    while parent[chain[-1]] >= 0:
+        chain.append(parent[chain[-1]])
+    return chain
+
+
 @pytest.mark.parametrize("changes, what", [
     (dict(joint_type=(J.REVOLUTE, 7)), "unknown joint type code"),
     (dict(joint_type=(J.REVOLUTE, J.FREE)), "free joint must attach to the world"),

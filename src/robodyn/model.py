@@ -351,10 +351,12 @@ class Model:
         argument of every call. They are private to the model, whose public arrays are
         read-only.
 
-        ``ints`` (nb, 6): parent, joint type, idx_q, idx_v, nv of the joint, and the axis code:
+        ``ints`` (nb, 7): parent, joint type, idx_q, idx_v, nv of the joint, the axis code:
         ``r`` when the joint has one dof whose motion subspace is the unit vector ``e_r`` of
         the body frame (most URDF joints: the kernels then skip the products with zeros),
-        else -1;
+        else -1, and the end of the body's subtree dofs: the dofs of the body and of its
+        descendants all lie in ``idx_v <= k < end`` (exactly those dofs when the bodies are
+        numbered depth first, as the builder does);
         ``body`` (nb, 52): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10), joint
         constants (27, ``joints.joint_constants``);
         ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
@@ -366,12 +368,16 @@ class Model:
         argument costs Numba's dispatcher about 0.1 us (``_inputs.unpack`` takes it apart).
         """
         nb, nv = self.nbodies, self.nv
-        ints = np.zeros((nb, 6), dtype=np.int64)
+        ints = np.zeros((nb, 7), dtype=np.int64)
         ints[:, 0] = self.parent
         ints[:, 1] = self.joint_type
         ints[:, 2] = self.idx_q
         ints[:, 3] = self.idx_v
         ints[:, 4] = J.NV[self.joint_type] if nb else 0
+        ints[:, 6] = ints[:, 3] + ints[:, 4]
+        for i in range(nb - 1, 0, -1):  # children after their parents: the ends gather to the root
+            if self.parent[i] >= 0:
+                ints[self.parent[i], 6] = max(ints[self.parent[i], 6], ints[i, 6])
         body = np.zeros((nb, J.ROW_SIZE))
         body[:, 0:9] = self.X_tree_R.reshape(nb, 9)
         body[:, 9:12] = self.X_tree_p
