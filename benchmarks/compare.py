@@ -1,14 +1,16 @@
-"""Side-by-side timings: robodyn against Pinocchio and roboticstoolbox-python, same process.
+"""Side-by-side timings: robodyn against Pinocchio, roboticstoolbox-python and MuJoCo, same process.
 
-    python benchmarks/compare.py [--batch 100000] [--write]
+    python benchmarks/compare.py [--batch 100000] [--write] [--no-rtb] [--no-mujoco]
 
 Robots: Panda and Talos (reduced, floating base) from example-robot-data, both loaded by
 robodyn and by Pinocchio from the same URDF; PUMA 560 and Panda as DH models in robodyn
-(built-in) and in roboticstoolbox-python. Prints per-call / per-state times and the ratio
-robodyn / other (below 1: robodyn is faster). ``--write`` appends the tables to
-``benchmarks/RESULTS.md`` with the machine, the versions and this command line.
+(built-in) and in roboticstoolbox-python; Panda and Talos (fixed base) converted by MuJoCo
+from the same URDFs, for ``rnea`` against ``mj_inverse``. Prints per-call / per-state times
+and the ratio robodyn / other (below 1: robodyn is faster), after checking that the results
+agree on the timed states. ``--write`` appends the tables to ``benchmarks/RESULTS.md`` with
+the machine, the versions and this command line.
 
-Needs the test extras (``pip install ".[test]"``) and ``pip install roboticstoolbox-python``.
+Needs the test extras (``pip install ".[test]"``) and ``pip install roboticstoolbox-python mujoco``.
 """
 
 from __future__ import annotations
@@ -27,7 +29,8 @@ import numba
 import numpy as np
 
 import robodyn as rd
-from robodyn.bench import Timing, agreement, batch_timings, format_table, paired_us, per_call_us, single_call_timings
+from robodyn.bench import (Timing, agreement, batch_timings, format_table, paired_us, per_call_us, rel_error,
+                           single_call_timings, states)
 
 TOL = 1e-9  # the core dynamics' tolerance against Pinocchio
 
@@ -84,6 +87,73 @@ def rtb_section(batch: int) -> str:
             "\n```\n" + format_table(rows, other="rtb") + "\n```\n")
 
 
+def mujoco_model(urdf: str):
+    """MuJoCo's model of a URDF, for ``mj_inverse`` to compute what ``rnea`` does: the
+    geometry is left out (MuJoCo would need the mesh files; the dynamics do not use it), and
+    so are the constraint forces (joint limits), the passive forces (damping, springs) and
+    the armature, which robodyn's ``rnea(..., friction=False, armature=False)`` leaves out."""
+    import re
+
+    import mujoco
+
+    text = Path(urdf).read_text()
+    for tag in ("visual", "collision"):
+        text = re.sub(rf"<{tag}\b.*?</{tag}>", "", text, flags=re.S)
+    m = mujoco.MjModel.from_xml_string(text)
+    m.opt.disableflags |= (mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_DAMPER
+                           | mujoco.mjtDisableBit.mjDSBL_SPRING)
+    m.dof_armature[:] = 0.0
+    return m
+
+
+def mujoco_section() -> str:
+    """Single calls of ``rnea`` against MuJoCo's ``mj_inverse`` (which has no batched call) on
+    the fixed-base models that convert: Panda and Talos reduced (MuJoCo reads no floating
+    base from a URDF). MuJoCo numbers its dofs in its own order: the states are permuted once,
+    before the timing, by joint name."""
+    import mujoco
+
+    rows, errors = [], {}
+    for name, relpath in (("panda", "panda_description/urdf/panda.urdf"),
+                          ("talos", "talos_data/robots/talos_reduced.urdf")):
+        f = erd_urdf(relpath)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            model = rd.load_urdf(f)
+        m = mujoco_model(f)
+        d = mujoco.MjData(m)
+        if m.nv != model.nv or m.nq != model.nq:
+            raise SystemExit(f"{name}: MuJoCo's model has nq, nv = {m.nq}, {m.nv}, robodyn's {model.nq}, {model.nv}")
+        # order[k]: robodyn's dof of MuJoCo's dof k (every joint has one dof, q and v alike)
+        dof_of = {jn: int(model.idx_v[i]) for i, jn in enumerate(model.body_joint_names)}
+        order = np.array([dof_of[mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)] for j in range(m.njnt)])
+        order = order[np.argsort(m.jnt_dofadr)]
+        _, (Q, V, A) = states(model, 200)
+        err = 0.0
+        tau = rd.rnea(model, Q, V, A, friction=False, armature=False)
+        for s in range(Q.shape[0]):
+            d.qpos[:], d.qvel[:], d.qacc[:] = Q[s, order], V[s, order], A[s, order]
+            mujoco.mj_inverse(m, d)
+            err = max(err, rel_error(d.qfrc_inverse, tau[s, order]))
+        if not err <= TOL:
+            raise SystemExit(f"{name}: robodyn's rnea and MuJoCo's mj_inverse differ by {err:.3g} > {TOL:g}")
+        errors[name] = err
+        q, v, a = Q[0], V[0], A[0]
+        qm, vm, am = q[order], v[order], a[order]
+
+        def mj_call():
+            d.qpos[:], d.qvel[:], d.qacc[:] = qm, vm, am
+            mujoco.mj_inverse(m, d)
+            return d.qfrc_inverse
+
+        rows.append(Timing(f"{name} rnea / mj_inverse", *paired_us(
+            lambda: rd.rnea(model, q, v, a, friction=False, armature=False), mj_call)))
+    agree = ", ".join(f"{k} {e:.1e}" for k, e in errors.items())
+    return (f"### Fixed-base URDF models vs MuJoCo {mujoco.__version__} (single calls)\n"
+            "\n```\n" + format_table(rows, other="mujoco") + "\n```\n\n"
+            + f"Largest relative error of `rnea` against `mj_inverse` over 200 states: {agree}.\n")
+
+
 def import_time() -> str:
     """Wall time of ``import robodyn`` in a fresh process (kernels are compiled lazily)."""
     code = "import time; t = time.perf_counter(); import robodyn; print(time.perf_counter() - t)"
@@ -112,6 +182,7 @@ def main() -> None:
     p.add_argument("--batch", type=int, default=100_000)
     p.add_argument("--write", action="store_true", help="append the results to benchmarks/RESULTS.md")
     p.add_argument("--no-rtb", action="store_true", help="skip roboticstoolbox-python")
+    p.add_argument("--no-mujoco", action="store_true", help="skip MuJoCo")
     args = p.parse_args()
     t0 = time.time()
     parts = [f"## {machine()}\n", f"Command: `python benchmarks/compare.py {' '.join(sys.argv[1:])}`\n",
@@ -120,6 +191,8 @@ def main() -> None:
              pinocchio_section("Talos reduced", "talos_data/robots/talos_reduced.urdf", True, args.batch)]
     if not args.no_rtb:
         parts.append(rtb_section(args.batch))
+    if not args.no_mujoco:
+        parts.append(mujoco_section())
     text = "\n".join(parts)
     print(text)
     print(f"(ran in {time.time() - t0:.0f} s)")
