@@ -363,7 +363,7 @@ class Model:
         then armature, viscous and Coulomb friction, zeroed when switched off;
         ``params[with_gravity]`` (4,): gravity (3, or zeros) and the Coulomb smoothing;
         ``zero_wrench`` (nb, 6): no external wrench;
-        ``free_v``: the first dof of each free joint (a tuple, for the input checks);
+        ``free_bodies``: the bodies whose joint is free (a tuple, for the input checks);
         ``packed[(friction, armature)]``: ``body``, that ``dofs``, ``params[True]`` and
         ``zero_wrench`` raveled into one array, for the single-state fast paths, where each
         argument costs Numba's dispatcher about 0.1 us (``_inputs.unpack`` takes it apart).
@@ -408,9 +408,9 @@ class Model:
         zero_wrench = np.zeros((nb, 6))
         packed = {key: np.concatenate([body.ravel(), d.ravel(), params[True], zero_wrench.ravel()])
                   for key, d in dofs.items()}
-        free_v = tuple(int(self.idx_v[i]) for i in np.flatnonzero(self.joint_type == J.FREE))
+        free_bodies = tuple(int(i) for i in np.flatnonzero(self.joint_type == J.FREE))
         return dict(ints=ints, body=body, dofs=dofs, params=params, zero_wrench=zero_wrench, packed=packed,
-                    free_v=free_v)
+                    free_bodies=free_bodies)
 
     # -- display -----------------------------------------------------------------------
     def __repr__(self) -> str:

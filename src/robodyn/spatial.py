@@ -146,14 +146,17 @@ def shift_motion(d, m, out):
 
 
 @inline
-def unshift_force(d, f, out):
+def unshifted_force(d, f):
     """A force vector about the point ``d`` moved back about the first point, axes unchanged:
-    ``[f; n + d x f]`` (:func:`force_act` with ``R = 1``)."""
+    ``[f; n + d x f]`` (:func:`force_act` with ``R = 1``), as a tuple of 6."""
     f0, f1, f2 = f[0], f[1], f[2]
-    out[0], out[1], out[2] = f0, f1, f2
-    out[3] = f[3] + d[1] * f2 - d[2] * f1
-    out[4] = f[4] + d[2] * f0 - d[0] * f2
-    out[5] = f[5] + d[0] * f1 - d[1] * f0
+    return (f0, f1, f2, f[3] + d[1] * f2 - d[2] * f1, f[4] + d[2] * f0 - d[0] * f2, f[5] + d[0] * f1 - d[1] * f0)
+
+
+@inline
+def unshift_force(d, f, out):
+    """``out =`` :func:`unshifted_force` ``(d, f)``."""
+    out[0], out[1], out[2], out[3], out[4], out[5] = unshifted_force(d, f)
 
 
 @inline

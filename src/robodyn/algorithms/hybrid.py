@@ -62,12 +62,12 @@ def known_dofs(model, known_mask) -> np.ndarray:
         if not (np.issubdtype(mask.dtype, np.integer) and np.all((mask == 0) | (mask == 1))):
             raise ValueError(f"known_mask: expected booleans (or 0/1), got {mask.dtype} values {mask.tolist()}")
         mask = mask.astype(bool)
-    for k in model._kernel["free_v"]:
+    for i in model._kernel["free_bodies"]:
+        k = model.idx_v[i]
         block = mask[k:k + 6]
         if block.any() != block.all():
-            name = model.body_joint_names[int(np.flatnonzero(model.idx_v == k)[0])]
             raise ValueError(
-                f"known_mask: the six entries {k}..{k + 5} of free joint {name!r} must be "
+                f"known_mask: the six entries {k}..{k + 5} of free joint {model.body_joint_names[i]!r} must be "
                 f"all True (base acceleration given) or all False (base wrench given), got {block.tolist()}")
     return np.ascontiguousarray(mask)
 

@@ -17,13 +17,14 @@ Bodies are numbered after their ancestors, so the dofs of a body's subtree all c
 after its own first dof ``k_i``, before the end ``e_i`` of its subtree's dofs (``ints[i, 6]``):
 ``F_i`` and ``u_i`` are zero outside the columns ``k_i <= col < e_i`` (a unit force outside
 the subtree does not reach it in pass 2), where pass 2 runs. Pass 3 computes the upper
-triangle (columns ``>= k_i`` of the rows of body ``i``), then mirrors it. The column loops of
-a body with a one-dof joint (every body but a free-floating root) hold the joint's vectors in
-registers (:func:`bias_forces_one_dof`, :func:`accelerations_one_dof`).
+triangle (columns ``>= k_i`` of the rows of body ``i``), then mirrors it. Only a root's joint may
+have several dofs (a free joint); the column loops of every other body, whose joint has one
+dof, hold the joint's vectors in registers (:func:`bias_forces_one_dof`,
+:func:`accelerations_one_dof`).
 
 Coordinates: as in the ABA (``aba.py``), each body's quantities are expressed at its origin
 with the world's axes, so that ``iX_p`` is a pure shift by the vector ``d_i`` between the
-origins (:func:`robodyn.spatial.congruence_shift`, ``unshift_force``, ``shift_motion``).
+origins (:func:`robodyn.spatial.congruence_shift`, ``unshifted_force``, ``shifted_motion``).
 
 Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
 algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Table 7.1.
@@ -36,7 +37,7 @@ from numba import prange
 
 from .._jit import core, inline, kernel, parallel
 from ..joint_kernels import local_placement
-from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shift_motion, unshift_force,
+from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
 from . import _inputs
 from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
@@ -68,26 +69,26 @@ def workspace(nb, nv):
 
 @inline
 def bias_forces_one_dof(k, end, d, S, UD, F_i, F_p, Minv):
-    """Pass 2 of a body whose joint has the one dof ``k``, with the vectors held in registers
-    (the common case; the general loop in :func:`minv_one` reads them from the workspace, which
-    the compiler must assume each store may change): for the columns ``k <= col < end``,
-    ``u = e_k - S^T F_i``, then ``F_p += iX_p^T (F_i + U D^-1 u)``."""
+    """Pass 2 of a body whose joint has the one dof ``k`` (every body but a root), with the
+    joint's vectors and the shift held in registers (read from the workspace, which every
+    store into ``F`` may alias, they would be reloaded per column): for the columns
+    ``k <= col < end``, ``u = e_k - S^T F_i``, then ``F_p += iX_p^T (F_i + U D^-1 u)``."""
     s0, s1, s2, s3, s4, s5 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
     g0, g1, g2, g3, g4, g5 = UD[0, 0], UD[1, 0], UD[2, 0], UD[3, 0], UD[4, 0], UD[5, 0]
-    d0, d1, d2 = d[0], d[1], d[2]
+    shift = (d[0], d[1], d[2])
     for col in range(k, end):
         f = F_i[col]
         u = (1.0 if col == k else 0.0) - (s0 * f[0] + s1 * f[1] + s2 * f[2] + s3 * f[3] + s4 * f[4] + s5 * f[5])
         Minv[k, col] = u
-        f0, f1, f2 = f[0] + g0 * u, f[1] + g1 * u, f[2] + g2 * u
-        n0, n1, n2 = f[3] + g3 * u, f[4] + g4 * u, f[5] + g5 * u
+        f0, f1, f2, n0, n1, n2 = unshifted_force(
+            shift, (f[0] + g0 * u, f[1] + g1 * u, f[2] + g2 * u, f[3] + g3 * u, f[4] + g4 * u, f[5] + g5 * u))
         p = F_p[col]
         p[0] += f0
         p[1] += f1
         p[2] += f2
-        p[3] += n0 + d1 * f2 - d2 * f1
-        p[4] += n1 + d2 * f0 - d0 * f2
-        p[5] += n2 + d0 * f1 - d1 * f0
+        p[3] += n0
+        p[4] += n1
+        p[5] += n2
 
 
 @inline
@@ -97,11 +98,9 @@ def accelerations_one_dof(k, d, S, U, dinv, F_p, F_i, Minv):
     ``Minv[k, col] = D^-1 (u - U^T A')``, ``A_i = A' + S Minv[k, col]``."""
     s0, s1, s2, s3, s4, s5 = S[k, 0], S[k, 1], S[k, 2], S[k, 3], S[k, 4], S[k, 5]
     u0, u1, u2, u3, u4, u5 = U[k, 0], U[k, 1], U[k, 2], U[k, 3], U[k, 4], U[k, 5]
-    d0, d1, d2 = d[0], d[1], d[2]
+    shift = (d[0], d[1], d[2])
     for col in range(k, Minv.shape[1]):
-        a = F_p[col]
-        w0, w1, w2 = a[3], a[4], a[5]
-        v0, v1, v2 = a[0] - (d1 * w2 - d2 * w1), a[1] - (d2 * w0 - d0 * w2), a[2] - (d0 * w1 - d1 * w0)
+        v0, v1, v2, w0, w1, w2 = shifted_motion(shift, F_p[col])
         m = dinv * (Minv[k, col] - (u0 * v0 + u1 * v1 + u2 * v2 + u3 * w0 + u4 * w1 + u5 * w2))
         Minv[k, col] = m
         b = F_i[col]
@@ -130,7 +129,9 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i], True)
         F[i, ints[i, 3]:ints[i, 6], :] = 0.0  # pass 2 uses the columns of the subtree only
     # Pass 2: articulated inertias and the bias forces of the unit joint forces;
-    # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it
+    # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it.
+    # Only a root's joint has several dofs (a free joint attaches to the world: see Model),
+    # so a body with a parent has the one dof iv.
     for i in range(nb - 1, -1, -1):
         par, iv, n, end = ints[i, 0], ints[i, 3], ints[i, 4], ints[i, 6]
         if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
@@ -140,41 +141,24 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         if par >= 0:
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             congruence_shift(d[i], upper_triangle(Ia), IA[par], True)
-        if par >= 0 and n == 1:
             bias_forces_one_dof(iv, end, d[i], S, UD, F[i], F[par], Minv)
             continue
-        for k in range(iv, iv + n):
+        for k in range(iv, iv + n):  # a root: u_i only
             for col in range(iv, end):
                 s = 0.0
                 for r in range(6):
                     s += S[k, r] * F[i, col, r]
                 Minv[k, col] = (1.0 if col == k else 0.0) - s
-        if par >= 0:
-            for col in range(iv, end):
-                for r in range(6):
-                    s = F[i, col, r]
-                    for j in range(n):
-                        s += UD[r, j] * Minv[iv + j, col]
-                    t2[r] = s
-                unshift_force(d[i], t2, t1)
-                for r in range(6):
-                    F[par, col, r] += t1[r]
     # Pass 3: accelerations of the unit joint forces (F now holds the body accelerations)
     for i in range(nb):
         par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        if par >= 0 and n == 1:
+        if par >= 0:
             accelerations_one_dof(iv, d[i], S, U, Dinv[iv, 0], F[par], F[i], Minv)
             continue
-        for col in range(iv, nv):
-            if par >= 0:
-                shift_motion(d[i], F[par, col], t2)
-            else:
-                t2[:] = 0.0
-            for k in range(iv, iv + n):
-                s = 0.0
-                for r in range(6):
-                    s += U[k, r] * t2[r]
-                t1[k - iv] = Minv[k, col] - s
+        for col in range(iv, nv):  # a root: A_i' = 0
+            for k in range(n):
+                t1[k] = Minv[iv + k, col]
+            t2[:] = 0.0
             for j in range(iv, iv + n):
                 s = 0.0
                 for k in range(n):
