@@ -2,23 +2,35 @@
 
 ``kernel``: a compiled function that may allocate (workspaces, single-state drivers), cached
 on disk. ``parallel``: a batch driver whose ``prange`` loop runs on all threads.
-``core``: an algorithm's per-state body, and ``inline``: a small helper inlined into its
-callers; both run without Numba's reference counting (``_nrt=False``), which would
-otherwise add atomic increments and decrements of every array passed to a helper (a
-several-fold slowdown of the inner loops). They must not allocate: workspaces come from
-their callers.
+``core``: an algorithm's per-state body, and ``inline``: a helper inlined into its callers;
+both run without Numba's reference counting (``_nrt=False``), which would otherwise add
+atomic increments and decrements of every array passed to a helper (a several-fold slowdown
+of the inner loops). They must not allocate (workspaces come from their callers), and an
+``inline`` or ``core`` function returns no array that owns memory: a view it returns is made
+by ``algorithms._workspace.view`` (which owns none), never an argument or a slice of one,
+since a caller that counts references would release it once too often.
+
+``inline`` functions are compiled once each, cached on disk like the others, and carry LLVM's
+``alwaysinline`` attribute (Numba's ``forceinline``): LLVM copies them into every caller, so
+they cost no call, and compiling a kernel costs the sum of its helpers compiled once each
+(Numba's own inlining, ``inline="always"``, copies and re-types a helper's IR at every call
+site, in time quadratic in its size: the ABA took minutes). Every other kind sets
+``forceinline=False`` explicitly, since Numba otherwise inherits the flag from whichever
+caller happens to compile a function first.
 
 ``fast(*argtypes)``: a single-state entry point compiled for exactly one argument signature
 (C-contiguous float64 arrays ``VEC``/``MAT`` for the state and the output, the model's
-``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``Model._pack``), a ``bool``).
+``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``layout.KernelTables``), a ``bool``).
 Compilation happens (or the cache is loaded) when the module defining it is imported, and the
-dispatcher compiles nothing else: any other argument types (lists, integers, strided or read-only arrays, batches) raise
-``TypeError``, on which the public function takes its general path.
+dispatcher compiles nothing else: any other argument types (lists, integers, strided or
+read-only arrays, batches) raise ``TypeError``, on which the public function takes its general
+path.
 
 All release the GIL (``nogil``), so Python threads run them concurrently (they share no
-state: every call allocates its own workspace). ``error_model="numpy"`` lets divisions by zero give inf/nan instead of raising (the kernels
-check their inputs and pivots themselves); ``fastmath`` allows fused multiply-add and
-reassociation but keeps NaN/Inf semantics, so the finiteness checks stay exact.
+state: every call allocates its own workspace). ``error_model="numpy"`` lets divisions by
+zero give inf/nan instead of raising (the kernels check their inputs and pivots themselves);
+``fastmath`` allows fused multiply-add and reassociation but keeps NaN/Inf semantics, so the
+finiteness checks stay exact.
 """
 
 from numba import njit
@@ -26,14 +38,15 @@ from numba import types as _types
 
 FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 _BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH, nogil=True)
+_CALLED = dict(_BASE, forceinline=False)
 
-kernel = njit(**_BASE)
-parallel = njit(parallel=True, **_BASE)
-core = njit(_nrt=False, **_BASE)
-inline = njit(inline="always", _nrt=False, **_BASE)
+kernel = njit(**_CALLED)
+parallel = njit(parallel=True, **_CALLED)
+core = njit(_nrt=False, **_CALLED)
+inline = njit(_nrt=False, **dict(_BASE, forceinline=True))
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
-# carries its accuracy (``sincos``); LLVM may still inline it, the flags stay per operation.
-exact = njit(_nrt=False, **{**_BASE, "fastmath": {"contract"}})
+# carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.
+exact = njit(_nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
 
 
 VEC = _types.Array(_types.float64, 1, "C")
@@ -44,4 +57,4 @@ MODEL_PACKED = _types.Array(_types.float64, 1, "C")
 
 def fast(*argtypes):
     """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only."""
-    return njit([_types.int64(*argtypes)], **_BASE)
+    return njit([_types.int64(*argtypes)], **_CALLED)

@@ -22,6 +22,7 @@ import numpy as np
 from .._jit import inline
 from .. import joints as J
 from ..joints import NQ, ROW_SIZE
+from ._workspace import view
 
 OK = 0
 NONFINITE = -1
@@ -47,13 +48,14 @@ def nq_of(ints):
 @inline
 def unpack(ints, packed):
     """Views ``(body, dofs, params, zero_wrench)`` of a model's ``packed`` kernel array (see
-    ``Model._pack``): (nb, ROW_SIZE), (nv, 9), (4,) and (nb, 6)."""
+    ``Model._pack``): (nb, ROW_SIZE), (nv, 9), (4,) and (nb, 6), owning no memory (see
+    ``_jit``)."""
     nb = ints.shape[0]
     nv = 0 if nb == 0 else ints[nb - 1, 3] + ints[nb - 1, 4]
     o1 = nb * ROW_SIZE
     o2 = o1 + 9 * nv
-    return (packed[:o1].reshape((nb, ROW_SIZE)), packed[o1:o2].reshape((nv, 9)), packed[o2:o2 + 4],
-            packed[o2 + 4:o2 + 4 + 6 * nb].reshape((nb, 6)))
+    return (view(packed, 0, (nb, ROW_SIZE)), view(packed, o1, (nv, 9)), view(packed, o2, (4,)),
+            view(packed, o2 + 4, (nb, 6)))
 
 
 @inline

@@ -51,7 +51,8 @@ SINGULAR_RTOL = 1e-12
 
 @inline
 def workspace_views(buf, nb, nv):
-    """The scratch arrays of :func:`hybrid_state` carved from ``buf`` (see :func:`workspace`)."""
+    """The scratch arrays of :func:`hybrid_state` carved from ``buf`` (see :func:`workspace`),
+    after ``buf`` itself (which an ``inline`` function may not return: see ``_jit``)."""
     P, o = poses(buf, 0, nb)
     vel, o = take(buf, o, (nb, 6))
     c, o = take(buf, o, (nb, 6))
@@ -69,7 +70,7 @@ def workspace_views(buf, nb, nv):
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
     tau, o = take(buf, o, (nv,))
-    return (buf, P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau)
+    return (P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau)
 
 
 @kernel
@@ -78,7 +79,7 @@ def workspace(nb, nv):
     Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
     of the joint forces and ``known`` is all False (no joint of known acceleration)."""
     buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
-    return workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
+    return (buf,) + workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
 
 
 @inline
@@ -349,16 +350,16 @@ def aligned_placement(i, par, Rl, pl, oR, op, d):
         oR[i, r, 2] = a0 * r02 + a1 * r12 + a2 * r22
 
 
+@inline
 def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
     """Hybrid dynamics of one state into ``qdd`` and ``tau`` (nv,) (RBDA section 9.2, see
     ``hybrid.py``). ``known[k]``: the acceleration of dof ``k`` is given (all dofs of a joint
     alike); with no dof known this is the ABA. Returns a status (see
     ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
 
-    Compiled twice (see below): as :func:`hybrid_one`, the function every single-state
-    caller shares, and inlined into the batch loop :func:`aba_range`, where a call per state
-    would cost about a tenth of the work. Numba's inlining copies a function in time
-    quadratic in its size (a minute or more for this one), so there is no other inlined copy.
+    Inlined into :func:`hybrid_one`, the function every single-state caller shares, and into
+    the batch loop :func:`aba_range`, where a call per state would cost about a tenth of the
+    work.
 
     Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
     module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
@@ -498,8 +499,10 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     return result_status(check, finite(qdd) and finite(tau))
 
 
-hybrid_one = core(hybrid_state)
-_hybrid_inlined = inline(hybrid_state)
+@core
+def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws):
+    """:func:`hybrid_state` of one state (the compiled function other kernels call)."""
+    return hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws)
 
 
 @core
@@ -515,9 +518,9 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
 def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
     """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`).
     The views of ``ws`` are rebuilt here, so that the compiler sees their shapes."""
-    ws = workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
+    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
     for s in range(lo, hi):
-        status[s] = _hybrid_inlined(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
+        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
                                     F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
 
 

@@ -27,18 +27,20 @@ from .kinematics import poses_checked, world_motion_subspace
 
 @inline
 def workspace_views(buf, nb, nv):
-    """The scratch arrays of :func:`crba_state` carved from ``buf`` (see :func:`workspace`)."""
+    """The scratch arrays of :func:`crba_state` carved from ``buf`` (see :func:`workspace`),
+    after ``buf`` itself (which an ``inline`` function may not return: see ``_jit``)."""
     P, o = poses(buf, 0, nb)
     oS, o = take(buf, o, (nv, 6))
     Ic, o = take(buf, o, (nb, 10))
     F, o = take(buf, o, (6,))
-    return (buf, P, oS, Ic, F)
+    return (P, oS, Ic, F)
 
 
 @kernel
 def workspace(nb, nv):
     """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
-    return workspace_views(np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6), nb, nv)
+    buf = np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6)
+    return (buf,) + workspace_views(buf, nb, nv)
 
 
 @inline
@@ -89,7 +91,7 @@ def crba_one(ints, body, dofs, q, check, M, ws):
 def crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws):
     """:func:`crba_state` of the states ``lo <= s < hi`` of a batch. The views of ``ws`` are
     rebuilt here, so that the compiler sees their shapes."""
-    ws = workspace_views(ws[0], ints.shape[0], dofs.shape[0])
+    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0])
     for s in range(lo, hi):
         status[s] = crba_state(ints, body, dofs, Q[s], check, MM[s], ws)
 

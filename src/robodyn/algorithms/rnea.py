@@ -32,7 +32,8 @@ from ._schedule import chunks, claim
 
 @inline
 def workspace_views(buf, nb):
-    """The scratch arrays of :func:`rnea_state` carved from ``buf`` (see :func:`workspace`)."""
+    """The scratch arrays of :func:`rnea_state` carved from ``buf`` (see :func:`workspace`),
+    after ``buf`` itself (which an ``inline`` function may not return: see ``_jit``)."""
     P, o = poses(buf, 0, nb)
     vel, o = take(buf, o, (nb, 6))
     acc, o = take(buf, o, (nb, 6))
@@ -40,13 +41,14 @@ def workspace_views(buf, nb):
     vJ, o = take(buf, o, (6,))
     t1, o = take(buf, o, (6,))
     t2, o = take(buf, o, (6,))
-    return (buf, P, vel, acc, f, vJ, t1, t2)
+    return (P, vel, acc, f, vJ, t1, t2)
 
 
 @kernel
 def workspace(nb):
     """Scratch of :func:`rnea_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2)``."""
-    return workspace_views(np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18), nb)
+    buf = np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18)
+    return (buf,) + workspace_views(buf, nb)
 
 
 @kernel
@@ -170,7 +172,7 @@ def rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, 
     """:func:`rnea_state` of the states ``lo <= s < hi`` of a batch (``F`` has one row per
     state, or a single row for all). The views of ``ws`` are rebuilt here, so that the
     compiler sees their shapes."""
-    ws = workspace_views(ws[0], ints.shape[0])
+    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0])
     for s in range(lo, hi):
         status[s] = rnea_state(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0],
                                fcode, check, TAU[s], ws)

@@ -1,0 +1,65 @@
+"""Cold start: how long the first call of each algorithm takes on a fresh install.
+
+Runs a child process with an empty Numba cache directory (``NUMBA_CACHE_DIR`` set to a new
+temporary directory, so the caches of this installation are left alone) and times, in order:
+``import robodyn``, the first single-state and the first batched call of ``rnea``, ``aba``,
+``crba`` and ``coriolis_matrix``, then ``rd.warmup()`` for everything else. A second child
+process with the same cache directory then shows the cost of a later start.
+
+    python benchmarks/cold_start.py            # all of it (a few minutes)
+    python benchmarks/cold_start.py rnea aba   # only these algorithms, no warmup
+"""
+
+import os
+import subprocess
+import sys
+import tempfile
+
+CHILD = r"""
+import sys, time
+t0 = time.perf_counter()
+import numpy as np
+import robodyn as rd
+from robodyn.random import random_model, random_state
+total = time.perf_counter() - t0
+print(f"  {'import robodyn':<34} {total:8.2f} s  (total {total:7.2f} s)", flush=True)
+which = sys.argv[1:]
+model = random_model(3, seed=0, floating_base=True)
+q, v, a = random_state(model, np.random.default_rng(0), ())
+Q, V, A = random_state(model, np.random.default_rng(0), (4,))
+args = {"rnea": (q, v, a), "aba": (q, v, a), "crba": (q,), "coriolis_matrix": (q, v)}
+batch = {"rnea": (Q, V, A), "aba": (Q, V, A), "crba": (Q,), "coriolis_matrix": (Q, V)}
+
+def timed(label, f):
+    global total
+    t = time.perf_counter()
+    f()
+    dt = time.perf_counter() - t
+    total += dt
+    print(f"  {label:<34} {dt:8.2f} s  (total {total:7.2f} s)", flush=True)
+
+for name in which:
+    if name == "warmup":
+        timed("rd.warmup() (everything else)", rd.warmup)
+        continue
+    timed(name + ", one state", lambda: getattr(rd, name)(model, *args[name]))
+    timed(name + ", batch of 4", lambda: getattr(rd, name)(model, *batch[name]))
+"""
+
+
+def run(names, cache):
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache)
+    subprocess.run([sys.executable, "-c", CHILD, *names], env=env, check=True)
+
+
+def main():
+    names = sys.argv[1:] or ["rnea", "aba", "crba", "coriolis_matrix", "warmup"]
+    with tempfile.TemporaryDirectory() as cache:
+        print("first start (empty cache):", flush=True)
+        run(names, cache)
+        print("second start (cache filled):", flush=True)
+        run(names, cache)
+
+
+if __name__ == "__main__":
+    main()
