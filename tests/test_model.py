@@ -190,21 +190,22 @@ def test_loaded_models_have_parent_before_child(model):
 
 @pytest.mark.parametrize("seed", range(6))
 def test_kernel_table_holds_the_end_of_each_subtree(seed):
-    """``ints[i, 6]`` bounds the dofs of body ``i``'s subtree: every one of them lies in
+    """``ints[i, SUBTREE_END]`` bounds the dofs of body ``i``'s subtree: every one of them lies in
     ``idx_v[i] <= k < end``, and ``end`` is the end of one of them (so, numbered depth first
     as the builder numbers them, the range holds exactly the subtree's dofs)."""
+    from robodyn.layout import NDOF, SUBTREE_END
     from robodyn.random import random_model
 
     depth_first = small_tree_builder().build()
     for m in (random_model(9, seed=seed, floating_base=bool(seed % 2), branching=0.5), depth_first):
-        ints = m._kernel["ints"]
+        ints = m.kernel.ints
         for i in range(m.nbodies):
             subtree = [j for j in range(m.nbodies) if i in _ancestors_and_self(m.parent, j)]
-            ends = [m.idx_v[j] + ints[j, 4] for j in subtree]
+            ends = [m.idx_v[j] + ints[j, NDOF] for j in subtree]
             assert all(m.idx_v[j] >= m.idx_v[i] for j in subtree)
-            assert ints[i, 6] == max(ends), (m.name, i)
+            assert ints[i, SUBTREE_END] == max(ends), (m.name, i)
             if m is depth_first:
-                assert ints[i, 6] - m.idx_v[i] == sum(ints[j, 4] for j in subtree)
+                assert ints[i, SUBTREE_END] - m.idx_v[i] == sum(ints[j, NDOF] for j in subtree)
 
 
 def _ancestors_and_self(parent, j):

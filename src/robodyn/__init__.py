@@ -48,7 +48,7 @@ def __getattr__(name):
         globals()[name] = value
         return value
     if name == "warmup":
-        from .warmup import warmup
+        from ._warmup import warmup
 
         return warmup
     raise AttributeError(f"module 'robodyn' has no attribute {name!r}")

@@ -7,7 +7,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import inline
-from .joints import PRISMATIC, QUAT_TOL, REVOLUTE, ROW_JOINT, ROW_XTREE_P
+from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, XTREE_P, XTREE_R
+from .joints import PRISMATIC, QUAT_TOL, REVOLUTE
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
@@ -21,10 +22,10 @@ def _mix(row, j, c, s):
 @inline
 def local_placement(jtype, row, q, iq, Rj):
     """``(ok, R, p)``: the placement of a body in its parent, ``X_tree * X_J(q)``, from the
-    body's kernel row (``Model._pack``), as values: ``R`` a 9-tuple (row by row), ``p`` a
+    body's kernel row (``layout.pack``), as values: ``R`` a 9-tuple (row by row), ``p`` a
     3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a free joint's quaternion is
     farther than ``QUAT_TOL`` from unit norm (a near-unit quaternion is normalised)."""
-    P, J = ROW_XTREE_P, ROW_JOINT
+    P, J, R = XTREE_P, JOINT_CONSTANTS, XTREE_R
     if jtype == REVOLUTE:
         s, c = sincos(q[iq])
         return (True, (_mix(row, J, c, s), _mix(row, J + 1, c, s), _mix(row, J + 2, c, s), _mix(row, J + 3, c, s),
@@ -33,7 +34,8 @@ def local_placement(jtype, row, q, iq, Rj):
                 (row[P], row[P + 1], row[P + 2]))
     if jtype == PRISMATIC:
         x = q[iq]
-        return (True, (row[0], row[1], row[2], row[3], row[4], row[5], row[6], row[7], row[8]),
+        return (True, (row[R], row[R + 1], row[R + 2], row[R + 3], row[R + 4], row[R + 5], row[R + 6], row[R + 7],
+                       row[R + 8]),
                 (row[P] + row[J] * x, row[P + 1] + row[J + 1] * x, row[P + 2] + row[J + 2] * x))
     # FREE: X_tree * (rotation of the quaternion, position)
     n = np.sqrt(q[iq + 3] * q[iq + 3] + q[iq + 4] * q[iq + 4] + q[iq + 5] * q[iq + 5] + q[iq + 6] * q[iq + 6])
@@ -67,9 +69,9 @@ def body_placement(jtype, row, q, iq, R, p, Rj):
 def friction_torque(dofs, eps, v, k):
     """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
 
-    ``dofs[k, 6:9] = [armature, b (viscous), Fc (Coulomb)]``; ``sgn`` is ``sign`` when
+    ``dofs[k, DAMPING] = b`` (viscous), ``dofs[k, COULOMB] = Fc``; ``sgn`` is ``sign`` when
     ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
     """
     vk = v[k]
     s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
-    return dofs[k, 7] * vk + dofs[k, 8] * s
+    return dofs[k, DAMPING] * vk + dofs[k, COULOMB] * s

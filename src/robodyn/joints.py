@@ -44,11 +44,6 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
 QUAT_TOL = 1e-3
 
 
-# Layout of a body's row in the kernels' ``body`` array (see ``Model._pack``).
-ROW_XTREE_R, ROW_XTREE_P, ROW_AXIS, ROW_INERTIA, ROW_JOINT = 0, 9, 12, 15, 25
-ROW_SIZE = ROW_JOINT + 27
-
-
 def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray) -> np.ndarray:
     """Constants (27,) that make ``joint_kernels.body_placement`` cheap for a joint type.
 

@@ -25,6 +25,7 @@ from . import joints as J
 
 
 from .errors import ModelError
+from .layout import pack
 
 
 # Tolerances of the physical-consistency checks of inertias: relative to the largest principal
@@ -126,7 +127,7 @@ class Model:
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
         "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
-        "physical", "_kernel", "_frame_index",
+        "physical", "kernel", "_frame_index",
     )
 
     def __init__(
@@ -276,7 +277,7 @@ class Model:
         setattr_(self, "frame_p", _readonly(fp))
         index = {n: i for i, n in enumerate(all_names)}
         setattr_(self, "_frame_index", index)
-        setattr_(self, "_kernel", self._pack())
+        setattr_(self, "kernel", pack(self))
 
     def __setattr__(self, key, value):
         raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
@@ -342,75 +343,6 @@ class Model:
             return int(body) % self.nbodies
         b, _, _ = self.frame_index(body)
         return b
-
-    # -- kernel layout -----------------------------------------------------------------
-    def _pack(self) -> dict:
-        """Arrays handed to the compiled kernels (few arguments, contiguous). They stay
-        writeable, although the kernels only read them: Numba's dispatcher types a writeable
-        C-contiguous array from a cache and a read-only one in Python, about 0.25 us more per
-        argument of every call. They are private to the model, whose public arrays are
-        read-only.
-
-        ``ints`` (nb, 7): parent, joint type, idx_q, idx_v, nv of the joint, the axis code:
-        ``r`` when the joint has one dof whose motion subspace is the unit vector ``e_r`` of
-        the body frame (most URDF joints: the kernels then skip the products with zeros),
-        else -1, and the end of the body's subtree dofs: the dofs of the body and of its
-        descendants all lie in ``idx_v <= k < end`` (exactly those dofs when the bodies are
-        numbered depth first, as the builder does);
-        ``body`` (nb, 52): X_tree R (row-major 9), X_tree p (3), axis (3), inertia (10), joint
-        constants (27, ``joints.joint_constants``);
-        ``dofs[(friction, armature)]`` (nv, 9): motion subspace column in the child frame (6),
-        then armature, viscous and Coulomb friction, zeroed when switched off;
-        ``params[with_gravity]`` (4,): gravity (3, or zeros) and the Coulomb smoothing;
-        ``zero_wrench`` (nb, 6): no external wrench;
-        ``free_bodies``: the bodies whose joint is free (a tuple, for the input checks);
-        ``packed[(friction, armature)]``: ``body``, that ``dofs``, ``params[True]`` and
-        ``zero_wrench`` raveled into one array, for the single-state fast paths, where each
-        argument costs Numba's dispatcher about 0.1 us (``_inputs.unpack`` takes it apart).
-        """
-        nb, nv = self.nbodies, self.nv
-        ints = np.zeros((nb, 7), dtype=np.int64)
-        ints[:, 0] = self.parent
-        ints[:, 1] = self.joint_type
-        ints[:, 2] = self.idx_q
-        ints[:, 3] = self.idx_v
-        ints[:, 4] = J.NV[self.joint_type] if nb else 0
-        ints[:, 6] = ints[:, 3] + ints[:, 4]
-        for i in range(nb - 1, 0, -1):  # children after their parents: the ends gather to the root
-            if self.parent[i] >= 0:
-                ints[self.parent[i], 6] = max(ints[self.parent[i], 6], ints[i, 6])
-        body = np.zeros((nb, J.ROW_SIZE))
-        body[:, 0:9] = self.X_tree_R.reshape(nb, 9)
-        body[:, 9:12] = self.X_tree_p
-        body[:, 12:15] = self.joint_axis
-        body[:, 15:25] = self.inertia
-        for i in range(nb):
-            body[i, J.ROW_JOINT:] = J.joint_constants(int(self.joint_type[i]), self.joint_axis[i], self.X_tree_R[i])
-        full = np.zeros((nv, 9))
-        for i in range(nb):
-            k = self.idx_v[i]
-            Si = J.motion_subspace(int(self.joint_type[i]), self.joint_axis[i])
-            full[k:k + Si.shape[0], :6] = Si
-        full[:, 6], full[:, 7], full[:, 8] = self.armature, self.damping, self.coulomb
-        for i in range(nb):
-            S = full[self.idx_v[i], :6]
-            unit = ints[i, 4] == 1 and np.count_nonzero(S) == 1 and S.max() == 1.0
-            ints[i, 5] = int(np.argmax(S)) if unit else -1
-        dofs = {}
-        for friction in (False, True):
-            for armature in (False, True):
-                d = full.copy()
-                d[:, 6] *= armature
-                d[:, 7:] *= friction
-                dofs[(friction, armature)] = d
-        params = {True: np.array([*self.gravity, self.coulomb_smoothing]),
-                  False: np.array([0.0, 0.0, 0.0, self.coulomb_smoothing])}
-        zero_wrench = np.zeros((nb, 6))
-        packed = {key: np.concatenate([body.ravel(), d.ravel(), params[True], zero_wrench.ravel()])
-                  for key, d in dofs.items()}
-        free_bodies = tuple(int(i) for i in np.flatnonzero(self.joint_type == J.FREE))
-        return dict(ints=ints, body=body, dofs=dofs, params=params, zero_wrench=zero_wrench, packed=packed,
-                    free_bodies=free_bodies)
 
     # -- display -----------------------------------------------------------------------
     def __repr__(self) -> str:

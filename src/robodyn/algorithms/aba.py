@@ -32,18 +32,21 @@ used by ``hybrid.py``): the ABA is its case with no joint of known acceleration.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean, prange
+from numba import boolean
 
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import friction_torque, local_placement
 from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
                        momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
                        wrench_to_aligned)
 from . import _inputs
+from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
-from ._schedule import chunks, claim
+from ._inputs import fits, nq_of, unpack
+from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
+from .driver import batch_kernel, chunks
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -155,11 +158,11 @@ def solve_block(A, y, n, G, x, tol):
 def free_root(ints, dofs, i):
     """True when body ``i`` is a root on a free joint without armature: its joint's
     ``D = S^T IA S`` needs no inverse (see :func:`hybrid_state`, pass 3)."""
-    if ints[i, 0] >= 0 or ints[i, 1] != FREE:
+    if ints[i, PARENT] >= 0 or ints[i, JTYPE] != FREE:
         return False
-    iv = ints[i, 3]
+    iv = ints[i, IV]
     for k in range(iv, iv + 6):
-        if dofs[k, 6] != 0.0:
+        if dofs[k, ARMATURE] != 0.0:
             return False
     return True
 
@@ -177,7 +180,7 @@ def inertia_scale(IA_i):
 def joint_inertia(IA_i, S, dofs, iv, n, U, Dinv, G):
     """``U_k = IA_i S_k`` (rows ``iv..iv+n`` of ``U``) and ``D^-1 = (S^T IA_i S + armature)^-1``
     (rows ``iv..iv+n`` of ``Dinv``) for one joint, with ``S_k = S[k, :6]`` in the frame of
-    ``IA_i`` and the armature in ``dofs[k, 6]``. Returns False when ``D`` is singular: a pivot
+    ``IA_i`` and the armature in ``dofs[k, ARMATURE]``. Returns False when ``D`` is singular: a pivot
     below ``SINGULAR_RTOL`` times the scale of ``IA_i`` (NaN input propagates)."""
     scale = inertia_scale(IA_i)
     for k in range(iv, iv + n):
@@ -186,7 +189,7 @@ def joint_inertia(IA_i, S, dofs, iv, n, U, Dinv, G):
             d = 0.0
             for r in range(6):
                 d += S[j, r] * U[k, r]
-            Dinv[j, k - iv] = d + (dofs[k, 6] if j == k else 0.0)
+            Dinv[j, k - iv] = d + (dofs[k, ARMATURE] if j == k else 0.0)
     if n == 1:  # the common case: D is a scalar
         if abs(Dinv[iv, 0]) <= SINGULAR_RTOL * scale:
             return False
@@ -286,7 +289,7 @@ def joint_motion(iv, n, axis, R, dofs, v, S, vJ, vp, vel_i, c_i):
     """Motion subspace ``S[k]`` of a body's joint in world axes (``R`` the body's world
     rotation), its velocity ``vel_i = vp + vJ`` (``vp``: the parent's velocity at the body's
     origin, as values; ``vJ = S qd``) and ``c_i = vel_i x vJ``. ``axis`` >= 0 when the
-    joint's ``S`` is the unit motion ``e_axis`` (see ``Model._pack``): then ``S`` is a column
+    joint's ``S`` is the unit motion ``e_axis`` (see ``layout.pack``): then ``S`` is a column
     of ``R`` in one half and zero in the other, and nothing goes through ``vJ``."""
     v0, v1, v2, v3, v4, v5 = vp
     if axis >= 0:
@@ -358,7 +361,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
 
     Inlined into :func:`hybrid_one`, the function every single-state caller shares, and into
-    the batch loop :func:`aba_range`, where a call per state would cost about a tenth of the
+    the batch loop :func:`aba_at`, where a call per state would cost about a tenth of the
     work.
 
     Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
@@ -373,22 +376,22 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     if check and not (finite(q) and finite(v) and finite_where(qdd_known, known, True)
                       and finite_where(tau_known, known, False)):
         return NONFINITE
-    eps = params[3]
+    eps = params[SMOOTHING]
     # Pass 1: placements, velocities, velocity-product accelerations (with the known joint
     # accelerations), rigid-body inertias and bias forces
     for i in range(nb):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
-        ok, Rl, pl = local_placement(ints[i, 1], body[i], q, ints[i, 2], Rj)
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
+        ok, Rl, pl = local_placement(ints[i, JTYPE], body[i], q, ints[i, IQ], Rj)
         if not ok:
             return BAD_QUATERNION
         aligned_placement(i, par, Rl, pl, oR, op, d)
         vp = shifted_motion(d[i], vel[par]) if par >= 0 else (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
-        joint_motion(iv, n, ints[i, 5], oR[i], dofs, v, S, t1, vp, vel[i], c[i])
+        joint_motion(iv, n, ints[i, UNIT_AXIS], oR[i], dofs, v, S, t1, vp, vel[i], c[i])
         if known[iv]:
             for k in range(iv, iv + n):
                 for r in range(6):
                     c[i, r] += S[k, r] * qdd_known[k]
-        theta = inertia_rotated(oR[i], body[i, 15:25])
+        theta = inertia_rotated(oR[i], body[i, INERTIA:INERTIA_END])
         force_cross(vel[i], momentum(theta, vel[i]), pA[i])
         inertia_matrix(theta, IA[i], False)  # the upper triangle (see pass 2)
         if fcode >= 0:
@@ -400,18 +403,18 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     # to the upper triangle of IA_p only (the joints of one dof read no more); the other
     # joints complete theirs first.
     for i in range(nb - 1, -1, -1):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if n == 1 and not known[iv]:
-            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, v, iv), ints[i, 5]
+            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, v, iv), ints[i, UNIT_AXIS]
             if axis >= 3:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
-                                           3, 6)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, ARMATURE], c[i], pA[i], tau_f, iv, U[iv], Dinv, u,
+                                           t1, t2, 3, 6)
             elif axis >= 0:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
-                                           0, 3)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, ARMATURE], c[i], pA[i], tau_f, iv, U[iv], Dinv, u,
+                                           t1, t2, 0, 3)
             else:
-                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, 6], c[i], pA[i], tau_f, iv, U[iv], Dinv, u, t1, t2,
-                                           0, 6)
+                ok = articulate_single_dof(IA[i], S[iv], dofs[iv, ARMATURE], c[i], pA[i], tau_f, iv, U[iv], Dinv, u,
+                                           t1, t2, 0, 6)
             if not ok:
                 return i + 1
             if par < 0:
@@ -453,11 +456,11 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     # Pass 3: accelerations of the joints of unknown acceleration, forces of the others;
     # a_0 = -g needs no shift to a root's origin (its angular part is zero)
     for i in range(nb):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if par >= 0:
             shift_motion(d[i], acc[par], acc[i])
         else:
-            acc[i, 0], acc[i, 1], acc[i, 2] = -params[0], -params[1], -params[2]
+            acc[i, 0], acc[i, 1], acc[i, 2] = -params[GRAVITY], -params[GRAVITY + 1], -params[GRAVITY + 2]
             acc[i, 3], acc[i, 4], acc[i, 5] = 0.0, 0.0, 0.0
         for r in range(6):
             acc[i, r] += c[i, r]
@@ -470,7 +473,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 s = 0.0
                 for r in range(6):
                     s += S[k, r] * t1[r]
-                tau[k] = s + dofs[k, 6] * qdd_known[k] + friction_torque(dofs, eps, v, k)
+                tau[k] = s + dofs[k, ARMATURE] * qdd_known[k] + friction_torque(dofs, eps, v, k)
             continue
         if n == 1:
             s = 0.0
@@ -514,25 +517,21 @@ def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[18], fext, fcode, check, qdd, ws[17], ws)
 
 
-@core
-def aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws):
-    """The forward dynamics of the states ``lo <= s < hi`` of a batch (see :func:`aba_one`).
-    The views of ``ws`` are rebuilt here, so that the compiler sees their shapes."""
-    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0]) + (ws[18],)
-    for s in range(lo, hi):
-        status[s] = hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18],
-                                    F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws[17], ws)
+@inline
+def aba_at(args, s, ws):
+    """The forward dynamics of state ``s`` of a batch (see :func:`aba_one`)."""
+    ints, body, dofs, params, Q, V, T, F, fcode, check, QDD = args
+    return hybrid_state(ints, body, dofs, params, Q[s], V[s], QDD[s], T[s], ws[18], F[s if F.shape[0] > 1 else 0],
+                        fcode, check, QDD[s], ws[17], ws)
 
 
-@parallel
-def _aba_batch(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            aba_range(ints, body, dofs, params, Q, V, T, F, fcode, check, QDD, status, lo, hi, ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def aba_views(args, ws):
+    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0]) + (ws[18],)
+
+
+_aba_batch = batch_kernel(aba_at, workspace, aba_views)
 
 
 @kernel
@@ -567,26 +566,26 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
     leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
     """
-    k = model._kernel
+    k = model.kernel
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
         qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
-            if _aba_packed(k["ints"], k["packed"][friction, armature], q, v, tau, check_finite, qdd) == OK:
+            if _aba_packed(k.ints, k.packed[friction, armature], q, v, tau, check_finite, qdd) == OK:
                 return qdd
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     qdd, result = _inputs.output(out, batch, (model.nv,), x)
     if batch == ():
-        status = _aba_single(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd)
+        status = _aba_single(k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd)
     else:
         B = x["q"].shape[0]
         status = np.empty(B, dtype=np.int64)
-        _aba_batch(k["ints"], k["body"], dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd, status,
-                   chunks(B))
-    bad = _inputs.raise_for_status(model, status, x, "aba")
+        _aba_batch((k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd),
+                   (model.nbodies, model.nv), status, chunks(B))
+    bad = raise_for_status(model, status, x, "aba")
     if bad:
         i = bad - 1
         raise ValueError(

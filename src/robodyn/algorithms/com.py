@@ -11,14 +11,15 @@ body ``i`` and ``S_k = [S_lin,k; S_ang,k]`` the world-frame motion subspace colu
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, kernel, parallel
+from .._jit import core, inline, kernel
+from ..layout import IV, NDOF, PARENT
 from . import _inputs
+from .status import raise_for_status
 from .crba import world_inertias
-from ._inputs import OK, finite, finite2, result_status
+from .status import OK, finite, finite2, result_status
 from .kinematics import poses_checked, world_motion_subspace
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
 @kernel
@@ -40,19 +41,19 @@ def com_one(ints, body, dofs, q, check, c, Jc, ws):
     for i in range(ints.shape[0] - 1, -1, -1):
         if Jc.shape[1] > 0:
             m, hx, hy, hz = Ic[i, 0], Ic[i, 1], Ic[i, 2], Ic[i, 3]
-            for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
+            for k in range(ints[i, IV], ints[i, IV] + ints[i, NDOF]):
                 wx, wy, wz = oS[k, 3], oS[k, 4], oS[k, 5]
                 Jc[0, k] = m * oS[k, 0] + wy * hz - wz * hy
                 Jc[1, k] = m * oS[k, 1] + wz * hx - wx * hz
                 Jc[2, k] = m * oS[k, 2] + wx * hy - wy * hx
-        par = ints[i, 0]
+        par = ints[i, PARENT]
         if par >= 0:
             for r in range(4):
                 Ic[par, r] += Ic[i, r]
     mass = 0.0
     c[:] = 0.0
     for i in range(ints.shape[0]):
-        if ints[i, 0] < 0:
+        if ints[i, PARENT] < 0:
             mass += Ic[i, 0]
             for r in range(3):
                 c[r] += Ic[i, 1 + r]
@@ -63,16 +64,14 @@ def com_one(ints, body, dofs, q, check, c, Jc, ws):
     return result_status(check, finite(c) and finite2(Jc))
 
 
-@parallel
-def _com_batch(ints, body, dofs, Q, check, C, JC, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def com_at(args, s, ws):
+    """The centre of mass and its Jacobian of state ``s`` of a batch."""
+    ints, body, dofs, Q, check, C, JC = args
+    return com_one(ints, body, dofs, Q[s], check, C[s], JC[s], ws)
+
+
+_com_batch = batch_kernel(com_at, workspace)
 
 
 @kernel
@@ -84,16 +83,17 @@ def _run(model, q, check_finite, with_jacobian, what):
     if model.total_mass <= 0:
         raise ValueError(f"{what}: the model has no mass: its centre of mass is undefined")
     batch, x = _inputs.states(model, q=q)
-    k = model._kernel
+    k = model.kernel
     Q = _inputs.as_batch(x["q"])
     B = Q.shape[0]
     C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
     status = np.empty(B, dtype=np.int64)
     if batch == ():  # one state: no parallel launch
-        status[0] = _com_single(k["ints"], k["body"], k["dofs"][(False, False)], Q[0], check_finite, C[0], JC[0])
+        status[0] = _com_single(k.ints, k.body, k.dofs[(False, False)], Q[0], check_finite, C[0], JC[0])
     else:
-        _com_batch(k["ints"], k["body"], k["dofs"][(False, False)], Q, check_finite, C, JC, status, chunks(B))
-    _inputs.raise_for_status(model, status, x, what)
+        _com_batch((k.ints, k.body, k.dofs[(False, False)], Q, check_finite, C, JC),
+                   (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, what)
     return batch, C, JC
 
 

@@ -34,7 +34,7 @@ import numpy as np
 from .. import joints as Jt
 from . import _inputs
 from .crba import crba
-from .jacobian import _frame as jacobian_frame, _run as jacobian_pass
+from .jacobian import jacobian_pass, moving_frame
 from .rnea import rnea
 
 # Eigenvalues of the Schur complement below this fraction of the largest are dropped.
@@ -101,7 +101,7 @@ def frame_kinematics(model, q, v, body, point=(0.0, 0.0, 0.0)) -> FrameKinematic
         zeros = np.zeros((B, 3, model.nv))
         return FrameKinematics(np.broadcast_to(np.eye(3), (B, 3, 3)), np.broadcast_to(point, (B, 3)), zeros, zeros,
                                np.zeros((B, 3)), np.zeros((B, 3)))
-    b, R_bf, p_bf = jacobian_frame(model, body)
+    b, R_bf, p_bf = moving_frame(model, body)
     r = p_bf + R_bf @ point
     oJ, oR, op, acc, vel = jacobian_pass(model, {"q": q, "v": v}, b, False, "constrained_dynamics")
     x = op + oR @ r

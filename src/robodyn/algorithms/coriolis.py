@@ -22,16 +22,19 @@ of the first kind ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean, prange
+from numba import boolean
 
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
+from .status import raise_for_status
 from .crba import world_inertias
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import OK, WRONG_SIZE, finite2, fits, nq_of, result_status, unpack
+from ._inputs import fits, nq_of, unpack
+from .status import OK, WRONG_SIZE, finite2, result_status
 from .kinematics import poses_checked, world_motion_subspace
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
 @kernel
@@ -93,7 +96,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     world_motion_subspace(ints, dofs, oR, op, oS)
     world_inertias(ints, body, oR, op, Ic)
     for i in range(nb):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         for r in range(6):
             oV[i, r] = oV[par, r] if par >= 0 else 0.0
         for k in range(iv, iv + n):
@@ -104,7 +107,7 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
         body_B(Ic[i], oV[i], K, Vx, h, Bc[i])
     C[:, :] = 0.0
     for i in range(nb - 1, -1, -1):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         for k in range(iv, iv + n):
             inertia_mul(Ic[i], oSd[k], F1)
             matvec6(Bc[i], oS[k], F2)
@@ -116,10 +119,10 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
                 C[l, k] = dot6(oS[l], F1)
             j = par
             while j >= 0:
-                for l in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+                for l in range(ints[j, IV], ints[j, IV] + ints[j, NDOF]):
                     C[l, k] = dot6(oS[l], F1)
                     C[k, l] = dot6(oSd[l], F2) + dot6(oS[l], F3)
-                j = ints[j, 0]
+                j = ints[j, PARENT]
         if par >= 0:
             for r in range(10):
                 Ic[par, r] += Ic[i, r]
@@ -129,16 +132,14 @@ def coriolis_one(ints, body, dofs, q, v, check, C, ws):
     return result_status(check, finite2(C))
 
 
-@parallel
-def _coriolis_batch(ints, body, dofs, Q, V, check, CC, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def coriolis_at(args, s, ws):
+    """The Coriolis matrix of state ``s`` of a batch."""
+    ints, body, dofs, Q, V, check, CC = args
+    return coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
+
+
+_coriolis_batch = batch_kernel(coriolis_at, workspace)
 
 
 @kernel
@@ -158,15 +159,15 @@ def _coriolis_packed(ints, packed, q, v, check, C):
 def _run(model, batch, x, check, what, out=None):
     """The Coriolis matrices of the checked states ``x`` into ``out`` (see ``_inputs.output``):
     returns ``(C, result)``, the kernel's flat array and the one to return."""
-    k = model._kernel
-    dofs, q, v = k["dofs"][(False, False)], x["q"], x["v"]
+    k = model.kernel
+    dofs, q, v = k.dofs[(False, False)], x["q"], x["v"]
     C, result = _inputs.output(out, batch, (model.nv, model.nv), x)
     if batch == ():
-        status = _coriolis_single(k["ints"], k["body"], dofs, q, v, check, C)
+        status = _coriolis_single(k.ints, k.body, dofs, q, v, check, C)
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
-        _coriolis_batch(k["ints"], k["body"], dofs, q, v, check, C, status, chunks(q.shape[0]))
-    _inputs.raise_for_status(model, status, x, what)
+        _coriolis_batch((k.ints, k.body, dofs, q, v, check, C), (model.nbodies, model.nv), status, chunks(q.shape[0]))
+    raise_for_status(model, status, x, what)
     return C, result
 
 
@@ -179,10 +180,10 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray |
     float64 array to write into and return (see :func:`robodyn.rnea`). Reference: Echeandia
     and Wensing (2021).
     """
-    k = model._kernel  # fast path for one state: the kernel checks sizes and values
+    k = model.kernel  # fast path for one state: the kernel checks sizes and values
     C = _inputs.fast_out(out, (model.nv, model.nv))
     try:
-        if _coriolis_packed(k["ints"], k["packed"][False, False], q, v, check_finite, C) == OK:
+        if _coriolis_packed(k.ints, k.packed[False, False], q, v, check_finite, C) == OK:
             return C
     except TypeError:  # not contiguous float64 arrays
         pass

@@ -14,14 +14,17 @@ Returns the full symmetric matrix.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean, prange
+from numba import boolean
 
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
 from . import _inputs
+from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
-from ._schedule import chunks, claim
+from ._inputs import fits, nq_of, unpack
+from .status import OK, WRONG_SIZE, finite, result_status
+from .driver import batch_kernel, chunks
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -47,13 +50,13 @@ def workspace(nb, nv):
 def world_inertias(ints, body, oR, op, Ic):
     """``Ic[i]``: inertial parameters of body ``i`` in world coordinates."""
     for i in range(ints.shape[0]):
-        inertia_act(oR[i], op[i], body[i, 15:25], Ic[i])
+        inertia_act(oR[i], op[i], body[i, INERTIA:INERTIA_END], Ic[i])
 
 
 @inline
 def crba_state(ints, body, dofs, q, check, M, ws):
     """``M`` (nv, nv) at ``q``; returns a status (see ``_inputs``). Inlined into
-    :func:`crba_one` (one state) and :func:`crba_range` (the batch loop)."""
+    :func:`crba_one` (one state) and :func:`crba_at` (the batch loop)."""
     _, (liR, lip, oR, op, Rj, pj), oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
@@ -64,17 +67,17 @@ def crba_state(ints, body, dofs, q, check, M, ws):
     world_inertias(ints, body, oR, op, Ic)
     M[:, :] = 0.0
     for i in range(ints.shape[0] - 1, -1, -1):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         for k in range(iv, iv + n):
             inertia_mul(Ic[i], oS[k], F)
             j = i
             while j >= 0:
-                for l in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+                for l in range(ints[j, IV], ints[j, IV] + ints[j, NDOF]):
                     val = dot6(oS[l], F)
                     M[l, k] = val
                     M[k, l] = val
-                j = ints[j, 0]
-            M[k, k] += dofs[k, 6]
+                j = ints[j, PARENT]
+            M[k, k] += dofs[k, ARMATURE]
         if par >= 0:
             for r in range(10):
                 Ic[par, r] += Ic[i, r]
@@ -87,24 +90,20 @@ def crba_one(ints, body, dofs, q, check, M, ws):
     return crba_state(ints, body, dofs, q, check, M, ws)
 
 
-@core
-def crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws):
-    """:func:`crba_state` of the states ``lo <= s < hi`` of a batch. The views of ``ws`` are
-    rebuilt here, so that the compiler sees their shapes."""
-    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0], dofs.shape[0])
-    for s in range(lo, hi):
-        status[s] = crba_state(ints, body, dofs, Q[s], check, MM[s], ws)
+@inline
+def crba_at(args, s, ws):
+    """:func:`crba_state` of state ``s`` of a batch."""
+    ints, body, dofs, Q, check, MM = args
+    return crba_state(ints, body, dofs, Q[s], check, MM[s], ws)
 
 
-@parallel
-def _crba_batch(ints, body, dofs, Q, check, MM, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            crba_range(ints, body, dofs, Q, check, MM, status, lo, hi, ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def crba_views(args, ws):
+    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0])
+
+
+_crba_batch = batch_kernel(crba_at, workspace, crba_views)
 
 
 @kernel
@@ -132,20 +131,21 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
-    k = model._kernel
+    k = model.kernel
     M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
-        if _crba_packed(k["ints"], k["packed"][False, armature], q, check_finite, M) == OK:
+        if _crba_packed(k.ints, k.packed[False, armature], q, check_finite, M) == OK:
             return M
     except (TypeError, KeyError):  # not contiguous float64 arrays (or armature not bool)
         pass
     batch, x = _inputs.states(model, q=q)
-    dofs, q = k["dofs"][(False, bool(armature))], x["q"]
+    dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)
     if batch == ():
-        status = _crba_single(k["ints"], k["body"], dofs, q, check_finite, M)
+        status = _crba_single(k.ints, k.body, dofs, q, check_finite, M)
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
-        _crba_batch(k["ints"], k["body"], dofs, q, check_finite, M, status, chunks(q.shape[0]))
-    _inputs.raise_for_status(model, status, x, "crba")
+        _crba_batch((k.ints, k.body, dofs, q, check_finite, M), (model.nbodies, model.nv), status,
+                    chunks(q.shape[0]))
+    raise_for_status(model, status, x, "crba")
     return result

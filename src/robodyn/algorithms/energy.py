@@ -10,15 +10,16 @@ Armature (rotor) kinetic energy is not included: it belongs to the motors, see `
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, kernel, parallel
+from .._jit import core, inline, kernel
+from ..layout import INERTIA, INERTIA_END
 from ..spatial import dot6, inertia_mul
 from . import _inputs
-from ._inputs import OK, finite, result_status
+from .status import raise_for_status
+from .status import OK, finite, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
 @core
@@ -32,7 +33,7 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     if v.shape[0] > 0:
         motion_pass(ints, dofs, liR, lip, v, zero_a, zero_g, vel, acc, vJ, t1, a0)
     for i in range(ints.shape[0]):
-        theta = body[i, 15:25]
+        theta = body[i, INERTIA:INERTIA_END]
         if v.shape[0] > 0:
             inertia_mul(theta, vel[i], t1)
             T += 0.5 * dot6(vel[i], t1)
@@ -44,16 +45,14 @@ def energy_one(ints, body, dofs, grav, q, v, check, out, ws):
     return result_status(check, finite(out))
 
 
-@parallel
-def _energy_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = motion_workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def energy_at(args, s, ws):
+    """Energies of state ``s`` of a batch (``V`` has one row per state, or one row for all)."""
+    ints, body, dofs, grav, Q, V, check, OUT = args
+    return energy_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
+
+
+_energy_batch = batch_kernel(energy_at, motion_workspace)
 
 
 @kernel
@@ -63,18 +62,18 @@ def _energy_single(ints, body, dofs, grav, q, v, check, out):
 
 def _run(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
-    k = model._kernel
+    k = model.kernel
     Q = _inputs.as_batch(x["q"])
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2)), np.empty(B, dtype=np.int64)
     if batch == ():  # one state: no parallel launch
-        status[0] = _energy_single(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q[0], V[0],
+        status[0] = _energy_single(k.ints, k.body, k.dofs[(False, False)], model.gravity, Q[0], V[0],
                                    check_finite, OUT[0])
     else:
-        _energy_batch(k["ints"], k["body"], k["dofs"][(False, False)], model.gravity, Q, V, check_finite, OUT, status,
-                      chunks(B))
-    _inputs.raise_for_status(model, status, x, what)
+        _energy_batch((k.ints, k.body, k.dofs[(False, False)], model.gravity, Q, V, check_finite, OUT),
+                      (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, what)
     return batch, OUT
 
 

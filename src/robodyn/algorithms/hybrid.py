@@ -24,26 +24,24 @@ the joint to the articulated subtree beyond it.
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import kernel, parallel
+from .._jit import inline, kernel
 from . import _inputs
-from ._inputs import OK
+from .status import raise_for_status
+from .status import OK
 from .aba import hybrid_one, workspace
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
-@parallel
-def _hybrid_batch(ints, body, dofs, params, Q, V, A, T, known, F, fcode, check, QDD, TAU, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = hybrid_one(ints, body, dofs, params, Q[s], V[s], A[s], T[s], known,
-                                       F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], TAU[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def hybrid_at(args, s, ws):
+    """Hybrid dynamics of state ``s`` of a batch (``F`` has one row per state, or one row for all)."""
+    ints, body, dofs, params, Q, V, A, T, known, F, fcode, check, QDD, TAU = args
+    return hybrid_one(ints, body, dofs, params, Q[s], V[s], A[s], T[s], known, F[s if F.shape[0] > 1 else 0],
+                      fcode, check, QDD[s], TAU[s], ws)
+
+
+_hybrid_batch = batch_kernel(hybrid_at, workspace)
 
 
 @kernel
@@ -62,7 +60,7 @@ def known_dofs(model, known_mask) -> np.ndarray:
         if not (np.issubdtype(mask.dtype, np.integer) and np.all((mask == 0) | (mask == 1))):
             raise ValueError(f"known_mask: expected booleans (or 0/1), got {mask.dtype} values {mask.tolist()}")
         mask = mask.astype(bool)
-    for i in model._kernel["free_bodies"]:
+    for i in model.kernel.free_bodies:
         k = model.idx_v[i]
         block = mask[k:k + 6]
         if block.any() != block.all():
@@ -103,16 +101,16 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     section 9.2.
     """
     known = known_dofs(model, known_mask)
-    k = model._kernel
-    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][True]
+    k = model.kernel
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
         a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
-        if _hybrid_single(k["ints"], k["body"], dofs, params, q, v, a_known, tau_known, known, k["zero_wrench"],
+        if _hybrid_single(k.ints, k.body, dofs, params, q, v, a_known, tau_known, known, k.zero_wrench,
                           -1, check_finite, a, tau) == OK:
             return a, tau
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    args = (k["ints"], k["body"], dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
+    args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
             check_finite)
     if batch == ():
         a, tau = np.empty(model.nv), np.empty(model.nv)
@@ -120,11 +118,11 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     else:
         B = x["q"].shape[0]
         a, tau, status = np.empty((B, model.nv)), np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
-        _hybrid_batch(*args, a, tau, status, chunks(B))
+        _hybrid_batch((*args, a, tau), (model.nbodies, model.nv), status, chunks(B))
     if np.any(status):
         report = {"q": x["q"], "v": x["v"], "a_known": np.where(known, x["a_known"], 0.0),
                   "tau_known": np.where(known, 0.0, x["tau_known"])}
-        bad = _inputs.raise_for_status(model, status, report, "hybrid_dynamics")
+        bad = raise_for_status(model, status, report, "hybrid_dynamics")
         i = bad - 1
         raise ValueError(
             f"hybrid_dynamics: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "

@@ -21,6 +21,7 @@ import numpy as np
 
 from .. import joints as J
 from . import _inputs
+from .status import require_finite_result
 
 # Below this angle the series expansions of the exponential's coefficients are used.
 _SMALL = 1e-4
@@ -123,7 +124,7 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
         quat = _quat_mul(quat0, dquat)
         quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
         out[..., kq + 3:kq + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
-    _inputs.require_finite_result("integrate", out, check_finite, {"q": q, "v": v})
+    require_finite_result("integrate", out, check_finite, {"q": q, "v": v})
     return _inputs.unflatten(out, batch)
 
 
@@ -150,7 +151,7 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
         conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
         dp = np.einsum("...ji,...j->...i", _quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
         d[..., kv:kv + 6] = log_se3(_quat_mul(conj0, quat1), dp)
-    return _inputs.require_finite_result("difference", d, check_finite, {"q0": q0, "q1": q1})
+    return require_finite_result("difference", d, check_finite, {"q0": q0, "q1": q1})
 
 
 def _as_configuration(model, name: str, a) -> np.ndarray:

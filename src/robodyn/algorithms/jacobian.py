@@ -17,15 +17,16 @@ frame when ``qdd = 0`` (and no gravity), spatial for ``"local"``/``"world"`` and
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, kernel, parallel
+from .._jit import core, inline, kernel
+from ..layout import IV, MOTION, NDOF, PARENT
 from ..spatial import motion_act
 from . import _inputs
-from ._inputs import OK, finite, finite2, result_status
+from .status import raise_for_status
+from .status import OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 FRAMES = ("world", "local", "local_world_aligned")
 
@@ -41,9 +42,9 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
     J[:, :] = 0.0
     j = b
     while j >= 0:
-        for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
-            motion_act(oR[j], op[j], dofs[k, :6], J[:, k])
-        j = ints[j, 0]
+        for k in range(ints[j, IV], ints[j, IV] + ints[j, NDOF]):
+            motion_act(oR[j], op[j], dofs[k, MOTION:MOTION + 6], J[:, k])
+        j = ints[j, PARENT]
     for r in range(3):
         opb[r] = op[b, r]
         for c in range(3):
@@ -56,17 +57,15 @@ def jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws
     return result_status(check, finite2(J) and (v.shape[0] == 0 or finite(acc_b)))
 
 
-@parallel
-def _jacobian_batch(ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = motion_workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s],
-                                         OP[s], ACC[s], VEL[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def jacobian_at(args, s, ws):
+    """The Jacobian pass of state ``s`` of a batch (``V`` has one row per state, or one row for all)."""
+    ints, body, dofs, Q, V, b, check, JJ, OR, OP, ACC, VEL = args
+    return jacobian_one(ints, body, dofs, Q[s], V[s if V.shape[0] > 1 else 0], b, check, JJ[s], OR[s], OP[s],
+                        ACC[s], VEL[s], ws)
+
+
+_jacobian_batch = batch_kernel(jacobian_at, motion_workspace)
 
 
 @kernel
@@ -75,26 +74,31 @@ def _jacobian_single(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b
     return jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws)
 
 
-def _run(model, x, b, check, what):
-    """Flat-batch results ``(J, oR_b, op_b, acc_b, vel_b)`` for the states ``x``."""
-    k = model._kernel
+def jacobian_pass(model, x, b, check, what):
+    """The pass behind the Jacobian functions, for the checked states ``x`` (``"q"``, optionally
+    ``"v"``, see ``_inputs.states``) and body ``b``: flat-batch arrays ``(J, oR_b, op_b, acc_b,
+    vel_b)`` of :func:`jacobian_one`: the world Jacobian (B, 6, nv), the body's world rotation
+    (B, 3, 3) and position (B, 3), and (with ``"v"``) its body-frame acceleration at
+    ``qdd = 0`` without gravity and velocity (B, 6); errors name ``what``."""
+    k = model.kernel
     q = _inputs.as_batch(x["q"])
     v = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = q.shape[0]
     JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
     ACC, VEL, status = np.empty((B, 6)), np.empty((B, 6)), np.empty(B, dtype=np.int64)
     if x["q"].ndim == 1:  # one state: no parallel launch
-        status[0] = _jacobian_single(k["ints"], k["body"], k["dofs"][(False, False)], q[0], v[0], b, check, JJ[0],
+        status[0] = _jacobian_single(k.ints, k.body, k.dofs[(False, False)], q[0], v[0], b, check, JJ[0],
                                      OR[0], OP[0], ACC[0], VEL[0])
     else:
-        _jacobian_batch(k["ints"], k["body"], k["dofs"][(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL,
-                        status, chunks(B))
-    _inputs.raise_for_status(model, status, x, what)
+        _jacobian_batch((k.ints, k.body, k.dofs[(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL),
+                        (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, what)
     return JJ, OR, OP, ACC, VEL
 
 
-def _frame(model, body):
-    """``(b, R, p)``: body index and placement in it of a body index or link/frame name."""
+def moving_frame(model, body):
+    """``(b, R, p)``: body index and placement in it of a body index or link/frame name; a frame
+    fixed to the world (whose Jacobian is zero) is an error."""
     if isinstance(body, (int, np.integer)):
         return model.body_index(body), np.eye(3), np.zeros(3)
     b, R, p = model.frame_index(body)
@@ -117,9 +121,9 @@ def jacobian(model, q, body, frame: str = "world", *, check_finite: bool = True)
     """
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
-    b, Rbf, pbf = _frame(model, body)
+    b, Rbf, pbf = moving_frame(model, body)
     batch, x = _inputs.states(model, q=q)
-    JJ, OR, OP, _, _ = _run(model, x, b, check_finite, "jacobian")
+    JJ, OR, OP, _, _ = jacobian_pass(model, x, b, check_finite, "jacobian")
     if frame != "world":
         Rf, pf = OR @ Rbf, OP + OR @ pbf
         lin = JJ[:, :3] - _cross(pf, JJ[:, 3:])
@@ -143,9 +147,9 @@ def jacobian_dot_times_v(model, q, v, body, frame: str = "world", *, check_finit
     ``qdd = 0``, so that its acceleration is ``J qdd + Jdot v``."""
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
-    b, Rbf, pbf = _frame(model, body)
+    b, Rbf, pbf = moving_frame(model, body)
     batch, x = _inputs.states(model, q=q, v=v)
-    _, OR, OP, ACC, VEL = _run(model, x, b, check_finite, "jacobian_dot_times_v")
+    _, OR, OP, ACC, VEL = jacobian_pass(model, x, b, check_finite, "jacobian_dot_times_v")
     # spatial acceleration and velocity in the frame's own coordinates (frame rigid on body b)
     acc_f = _rotate_T(np.broadcast_to(Rbf, OR.shape), _shift(ACC, pbf))
     if frame == "local":

@@ -11,14 +11,15 @@ passes here (``placements``, ``world_placements``) are the first pass of every a
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import inline, kernel, parallel
+from .._jit import inline, kernel
+from ..layout import IQ, IV, JTYPE, MOTION, NDOF, PARENT, UNIT_AXIS
 from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
-from ._schedule import chunks, claim
+from .status import raise_for_status
+from .status import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
+from .driver import batch_kernel, chunks
 
 
 @inline
@@ -28,7 +29,7 @@ def placements(ints, body, q, liR, lip, Rj, pj):
     Returns False when a free joint's quaternion is not of unit norm (see ``joints``).
     """
     for i in range(ints.shape[0]):
-        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+        if not body_placement(ints[i, JTYPE], body[i], q, ints[i, IQ], liR[i], lip[i], Rj):
             return False
     return True
 
@@ -50,28 +51,28 @@ def world_placement(i, par, liR, lip, oR, op):
 def world_placements(ints, liR, lip, oR, op):
     """``oR[i], op[i]``: placement of body ``i`` in the world from the local placements."""
     for i in range(ints.shape[0]):
-        world_placement(i, ints[i, 0], liR, lip, oR, op)
+        world_placement(i, ints[i, PARENT], liR, lip, oR, op)
 
 
 @inline
 def world_motion_subspace(ints, dofs, oR, op, oS):
     """``oS[k]``: motion subspace column ``k`` in world coordinates (``J`` of its body). A
-    joint along a body axis (``S = e_r``, ``ints[i, 5] = r``) takes column ``r`` of the
+    joint along a body axis (``S = e_r``, ``ints[i, UNIT_AXIS] = r``) takes column ``r`` of the
     rotation: ``[R e_r; 0]`` for a translation, ``[p x R e_r; R e_r]`` for a rotation."""
     for i in range(ints.shape[0]):
-        axis = ints[i, 5]
+        axis = ints[i, UNIT_AXIS]
         if axis >= 3:
-            R, p, k, c = oR[i], op[i], ints[i, 3], axis - 3
+            R, p, k, c = oR[i], op[i], ints[i, IV], axis - 3
             w0, w1, w2 = R[0, c], R[1, c], R[2, c]
             cross_into(p[0], p[1], p[2], w0, w1, w2, oS[k], 0)
             oS[k, 3], oS[k, 4], oS[k, 5] = w0, w1, w2
         elif axis >= 0:
-            R, k = oR[i], ints[i, 3]
+            R, k = oR[i], ints[i, IV]
             oS[k, 0], oS[k, 1], oS[k, 2] = R[0, axis], R[1, axis], R[2, axis]
             oS[k, 3], oS[k, 4], oS[k, 5] = 0.0, 0.0, 0.0
         else:
-            for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
-                motion_act(oR[i], op[i], dofs[k, :6], oS[k])
+            for k in range(ints[i, IV], ints[i, IV] + ints[i, NDOF]):
+                motion_act(oR[i], op[i], dofs[k, MOTION:MOTION + 6], oS[k])
 
 
 @inline
@@ -98,21 +99,20 @@ def _fk_single(ints, body, q, oR, op, check):
     return poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
 
 
-@parallel
-def _fk_batch(ints, body, Q, OR, OP, check, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        liR, lip, Rj, pj = workspace(ints.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def fk_at(args, s, ws):
+    """The world placements of state ``s`` of a batch."""
+    ints, body, Q, OR, OP, check = args
+    liR, lip, Rj, pj = ws
+    return poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
+
+
+_fk_batch = batch_kernel(fk_at, workspace)
 
 
 def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
     """World rotations (..., nb, 3, 3) and positions (..., nb, 3) of every body, flat batch."""
-    ints, body = model._kernel["ints"], model._kernel["body"]
+    ints, body = model.kernel.ints, model.kernel.body
     nb = model.nbodies
     if batch == ():
         oR, op = np.empty((nb, 3, 3)), np.empty((nb, 3))
@@ -120,8 +120,8 @@ def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> t
     else:
         B = q.shape[0]
         oR, op, status = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3)), np.empty(B, dtype=np.int64)
-        _fk_batch(ints, body, q, oR, op, check, status, chunks(B))
-    _inputs.raise_for_status(model, status, {"q": q}, what)
+        _fk_batch((ints, body, q, oR, op, check), (nb,), status, chunks(B))
+    raise_for_status(model, status, {"q": q}, what)
     return oR, op
 
 

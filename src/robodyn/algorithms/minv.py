@@ -14,7 +14,7 @@ Pass 3 (root to leaves), with ``A_0 = 0``: ``A_i' = iX_p A_p``,
 ``Minv[dofs of i, :] = D_i^-1 (u_i - U_i^T A_i')``, ``A_i = A_i' + S_i Minv[dofs of i, :]``.
 
 Bodies are numbered after their ancestors, so the dofs of a body's subtree all come at or
-after its own first dof ``k_i``, before the end ``e_i`` of its subtree's dofs (``ints[i, 6]``):
+after its own first dof ``k_i``, before the end ``e_i`` of its subtree's dofs (``ints[i, SUBTREE_END]``):
 ``F_i`` and ``u_i`` are zero outside the columns ``k_i <= col < e_i`` (a unit force outside
 the subtree does not reach it in pass 2), where pass 2 runs. Pass 3 computes the upper
 triangle (columns ``>= k_i`` of the rows of body ``i``), then mirrors it. Only a root's joint may
@@ -33,17 +33,19 @@ algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Tab
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import core, inline, kernel
+from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_END
 from ..joint_kernels import local_placement
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
 from . import _inputs
-from ._inputs import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, nq_of, result_status
+from .status import raise_for_status
+from ._inputs import nq_of
+from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from .aba import aligned_placement, articulated_inertia, joint_inertia
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
 @kernel
@@ -120,20 +122,20 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         return NONFINITE
     # Pass 1: placements, motion subspaces S[k] and rigid-body inertias in world axes
     for i in range(nb):
-        ok, Rl, pl = local_placement(ints[i, 1], body[i], q, ints[i, 2], Rj)
+        ok, Rl, pl = local_placement(ints[i, JTYPE], body[i], q, ints[i, IQ], Rj)
         if not ok:
             return BAD_QUATERNION
-        aligned_placement(i, ints[i, 0], Rl, pl, oR, op, d)
-        for k in range(ints[i, 3], ints[i, 3] + ints[i, 4]):
+        aligned_placement(i, ints[i, PARENT], Rl, pl, oR, op, d)
+        for k in range(ints[i, IV], ints[i, IV] + ints[i, NDOF]):
             rotate6(oR[i], dofs[k], S[k])
-        inertia_matrix(inertia_rotated(oR[i], body[i, 15:25]), IA[i], True)
-        F[i, ints[i, 3]:ints[i, 6], :] = 0.0  # pass 2 uses the columns of the subtree only
+        inertia_matrix(inertia_rotated(oR[i], body[i, INERTIA:INERTIA_END]), IA[i], True)
+        F[i, ints[i, IV]:ints[i, SUBTREE_END], :] = 0.0  # pass 2 uses the columns of the subtree only
     # Pass 2: articulated inertias and the bias forces of the unit joint forces;
     # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it.
     # Only a root's joint has several dofs (a free joint attaches to the world: see Model),
     # so a body with a parent has the one dof iv.
     for i in range(nb - 1, -1, -1):
-        par, iv, n, end = ints[i, 0], ints[i, 3], ints[i, 4], ints[i, 6]
+        par, iv, n, end = ints[i, PARENT], ints[i, IV], ints[i, NDOF], ints[i, SUBTREE_END]
         if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
             return i + 1
         for k in range(iv, iv + n):
@@ -151,7 +153,7 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
                 Minv[k, col] = (1.0 if col == k else 0.0) - s
     # Pass 3: accelerations of the unit joint forces (F now holds the body accelerations)
     for i in range(nb):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if par >= 0:
             accelerations_one_dof(iv, d[i], S, U, Dinv[iv, 0], F[par], F[i], Minv)
             continue
@@ -174,16 +176,14 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
     return result_status(check, finite2(Minv))
 
 
-@parallel
-def _minv_batch(ints, body, dofs, Q, check, MM, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def minv_at(args, s, ws):
+    """The inverse mass matrix of state ``s`` of a batch."""
+    ints, body, dofs, Q, check, MM = args
+    return minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
+
+
+_minv_batch = batch_kernel(minv_at, workspace)
 
 
 @kernel
@@ -202,22 +202,22 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
     articulated inertia is singular (``M`` is then singular too). Reference: Carpentier and
     Mansard, RSS 2018 (Pinocchio's ``computeMinverse``); RBDA Table 7.1.
     """
-    k = model._kernel
-    dofs = k["dofs"][(False, bool(armature))]
+    k = model.kernel
+    dofs = k.dofs[(False, bool(armature))]
     if _inputs.vectors(q):
         Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
-        if _minv_single(k["ints"], k["body"], dofs, q, check_finite, Minv) == OK:
+        if _minv_single(k.ints, k.body, dofs, q, check_finite, Minv) == OK:
             return Minv
     batch, x = _inputs.states(model, q=q)
     q = x["q"]
     if batch == ():
         Minv = np.empty((model.nv, model.nv))
-        status = _minv_single(k["ints"], k["body"], dofs, q, check_finite, Minv)
+        status = _minv_single(k.ints, k.body, dofs, q, check_finite, Minv)
     else:
         B = q.shape[0]
         Minv, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
-        _minv_batch(k["ints"], k["body"], dofs, q, check_finite, Minv, status, chunks(B))
-    bad = _inputs.raise_for_status(model, status, x, "inverse_mass_matrix")
+        _minv_batch((k.ints, k.body, dofs, q, check_finite, Minv), (model.nbodies, model.nv), status, chunks(B))
+    bad = raise_for_status(model, status, x, "inverse_mass_matrix")
     if bad:
         i = bad - 1
         raise ValueError(

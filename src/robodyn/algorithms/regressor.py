@@ -41,17 +41,20 @@ about the joint frame origin, are these 10 parameters (the body frame is the joi
 from __future__ import annotations
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import core, inline, kernel
+from ..layout import IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
 from . import _inputs
-from ._inputs import NONFINITE, OK, finite, finite2, result_status
+from .status import raise_for_status
+from .status import NONFINITE, OK, finite, finite2, result_status
 from .kinematics import poses_checked
-from .rnea import motion_pass
-from ._schedule import chunks, claim
+from .rnea import base_acceleration, motion_pass
+from .driver import batch_kernel, chunks
 
 EXTRA_COLUMNS = ("viscous", "coulomb", "armature", "offset")
+# The flags of the extra columns follow the model's ``params`` in the kernels' ``params``.
+EXTRA_FLAGS = PARAMS_SIZE
 
 
 @kernel
@@ -80,24 +83,24 @@ def joint_rows(ints, dofs, liR, lip, i, W, Y, t1):
     ancestor ``j``. ``W`` is carried up the chain (overwritten)."""
     j = i
     while j >= 0:  # W holds A_i expressed in body j's frame
-        for k in range(ints[j, 3], ints[j, 3] + ints[j, 4]):
+        for k in range(ints[j, IV], ints[j, IV] + ints[j, NDOF]):
             for c in range(10):
-                Y[k, 10 * i + c] = dot6(dofs[k, :6], W[c])
-        if ints[j, 0] >= 0:
+                Y[k, 10 * i + c] = dot6(dofs[k, MOTION:MOTION + 6], W[c])
+        if ints[j, PARENT] >= 0:
             for c in range(10):
                 force_act(liR[j], lip[j], W[c], t1)
                 for r in range(6):
                     W[c, r] = t1[r]
-        j = ints[j, 0]
+        j = ints[j, PARENT]
 
 
 @inline
 def extra_rows(params, v, a, col, Y):
-    """The extra column blocks from column ``col`` on (flags ``params[4:8]``, see
-    ``EXTRA_COLUMNS``): ``v_k``, ``sgn v_k`` (smoothed when ``params[3] > 0``), ``a_k``, ``1``."""
-    nv, eps = v.shape[0], params[3]
+    """The extra column blocks from column ``col`` on (flags ``params[EXTRA_FLAGS:]``, see
+    ``EXTRA_COLUMNS``): ``v_k``, ``sgn v_k`` (smoothed when ``params[SMOOTHING] > 0``), ``a_k``, ``1``."""
+    nv, eps = v.shape[0], params[SMOOTHING]
     for block in range(4):
-        if params[4 + block] == 0.0:
+        if params[EXTRA_FLAGS + block] == 0.0:
             continue
         for k in range(nv):
             if block == 0:
@@ -116,7 +119,7 @@ def extra_rows(params, v, a, col, Y):
 def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
     """Joint-torque regressor of one state into ``Y`` (nv, 10 nb + extra columns); returns a
     status (see ``_inputs``). Columns past ``10 nb`` are the extra blocks in the order of
-    ``EXTRA_COLUMNS`` whose flags ``params[4:8]`` are non-zero."""
+    ``EXTRA_COLUMNS`` whose flags ``params[EXTRA_FLAGS:]`` are non-zero."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
     nb = ints.shape[0]
     status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
@@ -133,16 +136,14 @@ def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
     return result_status(check, finite2(Y))
 
 
-@parallel
-def _regressor_batch(ints, body, dofs, params, Q, V, A, check, Y, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def regressor_at(args, s, ws):
+    """The regressor of state ``s`` of a batch."""
+    ints, body, dofs, params, Q, V, A, check, Y = args
+    return regressor_one(ints, body, dofs, params, Q[s], V[s], A[s], check, Y[s], ws)
+
+
+_regressor_batch = batch_kernel(regressor_at, workspace)
 
 
 @kernel
@@ -167,11 +168,9 @@ def reference_motion_pass(ints, dofs, liR, lip, v, v_r, a_r, grav, vel, vel_r, a
 
     (``a_r,i = J_i qdd_r + Jdot_i qd_r``: the joint axes move with the true velocity).
     """
-    for k in range(6):
-        a0[k] = 0.0
-    a0[0], a0[1], a0[2] = -grav[0], -grav[1], -grav[2]
+    base_acceleration(grav, a0)
     for i in range(ints.shape[0]):
-        par, iv, n = ints[i, 0], ints[i, 3], ints[i, 4]
+        par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if par >= 0:
             motion_act_inv(liR[i], lip[i], vel[par], vel[i])
             motion_act_inv(liR[i], lip[i], vel_r[par], vel_r[i])
@@ -184,9 +183,9 @@ def reference_motion_pass(ints, dofs, liR, lip, v, v_r, a_r, grav, vel, vel_r, a
             vJ[r] = 0.0
         for k in range(iv, iv + n):
             for r in range(6):
-                vel[i, r] += dofs[k, r] * v[k]
-                vJ[r] += dofs[k, r] * v_r[k]
-                acc_r[i, r] += dofs[k, r] * a_r[k]
+                vel[i, r] += dofs[k, MOTION + r] * v[k]
+                vJ[r] += dofs[k, MOTION + r] * v_r[k]
+                acc_r[i, r] += dofs[k, MOTION + r] * a_r[k]
         for r in range(6):
             vel_r[i, r] += vJ[r]
         motion_cross(vel[i], vJ, t1)
@@ -234,16 +233,14 @@ def slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y,
     return result_status(check, finite2(Y))
 
 
-@parallel
-def _slotine_li_batch(ints, body, dofs, params, Q, V, VR, AR, check, Y, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = reference_workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = slotine_li_regressor_one(ints, body, dofs, params, Q[s], V[s], VR[s], AR[s], check, Y[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def slotine_li_at(args, s, ws):
+    """The Slotine-Li regressor of state ``s`` of a batch."""
+    ints, body, dofs, params, Q, V, VR, AR, check, Y = args
+    return slotine_li_regressor_one(ints, body, dofs, params, Q[s], V[s], VR[s], AR[s], check, Y[s], ws)
+
+
+_slotine_li_batch = batch_kernel(slotine_li_at, reference_workspace)
 
 
 @kernel
@@ -278,17 +275,14 @@ def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
     return result_status(check, finite2(out))
 
 
-@parallel
-def _energy_regressor_batch(ints, body, dofs, grav, Q, V, check, OUT, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0], dofs.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            for s in range(lo, hi):
-                status[s] = energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check,
-                                                 OUT[s], ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def energy_regressor_at(args, s, ws):
+    """The energy regressor of state ``s`` of a batch (``V`` has one row per state, or one row for all)."""
+    ints, body, dofs, grav, Q, V, check, OUT = args
+    return energy_regressor_one(ints, body, dofs, grav, Q[s], V[s if V.shape[0] > 1 else 0], check, OUT[s], ws)
+
+
+_energy_regressor_batch = batch_kernel(energy_regressor_at, workspace)
 
 
 @kernel
@@ -357,20 +351,20 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
     Reference: Khalil and Dombre (2002), section 12.3; Atkeson, An and Hollerbach (1986).
     """
     batch, x = _inputs.states(model, q=q, v=v, a=a)
-    k = model._kernel
+    k = model.kernel
     flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
-    params = np.concatenate([k["params"][True], flags])
+    params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
     B = Q.shape[0]
     Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
     if batch == ():  # one state: no parallel launch
-        status[0] = _regressor_single(k["ints"], k["body"], k["dofs"][(False, False)], params, Q[0], V[0], A[0],
+        status[0] = _regressor_single(k.ints, k.body, k.dofs[(False, False)], params, Q[0], V[0], A[0],
                                       check_finite, Y[0])
     else:
-        _regressor_batch(k["ints"], k["body"], k["dofs"][(False, False)], params, Q, V, A, check_finite, Y, status,
-                         chunks(B))
-    _inputs.raise_for_status(model, status, x, "regressor")
+        _regressor_batch((k.ints, k.body, k.dofs[(False, False)], params, Q, V, A, check_finite, Y),
+                         (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, "regressor")
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
 
@@ -412,35 +406,36 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, co
     1991; Echeandia and Wensing, J. Comput. Nonlinear Dynam. 16(9), 2021.
     """
     batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
-    k = model._kernel
+    k = model.kernel
     flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
-    params = np.concatenate([k["params"][True], flags])
+    params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
-    args = (k["ints"], k["body"], k["dofs"][(False, False)], params)
+    args = (k.ints, k.body, k.dofs[(False, False)], params)
     if batch == ():
         Y = np.empty((model.nv, ncol))
         status = _slotine_li_single(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y)
     else:
         B = x["q"].shape[0]
         Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
-        _slotine_li_batch(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y, status, chunks(B))
-    _inputs.raise_for_status(model, status, x, "slotine_li_regressor")
+        _slotine_li_batch((*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y),
+                          (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, "slotine_li_regressor")
     return _inputs.unflatten(Y, batch)
 
 
 def _energy(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
-    k = model._kernel
+    k = model.kernel
     Q = _inputs.as_batch(x["q"])
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2, 10 * model.nbodies)), np.empty(B, dtype=np.int64)
-    args = (k["ints"], k["body"], k["dofs"][(False, False)], model.gravity)
+    args = (k.ints, k.body, k.dofs[(False, False)], model.gravity)
     if B == 1:  # one state: no thread start-up of the batch driver
         status[0] = _energy_regressor_single(*args, Q[0], V[0], check_finite, OUT[0])
     else:
-        _energy_regressor_batch(*args, Q, V, check_finite, OUT, status, chunks(B))
-    _inputs.raise_for_status(model, status, x, what)
+        _energy_regressor_batch((*args, Q, V, check_finite, OUT), (model.nbodies, model.nv), status, chunks(B))
+    raise_for_status(model, status, x, what)
     return OUT.reshape(batch + OUT.shape[1:])
 
 

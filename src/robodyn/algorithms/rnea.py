@@ -17,17 +17,20 @@ Pass 2 (leaves to root)::
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean, prange
+from numba import boolean
 
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, parallel
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import body_placement, friction_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
 from . import _inputs
+from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, fits, nq_of, result_status, unpack
+from ._inputs import fits, nq_of, unpack
+from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
 from .kinematics import world_placement
-from ._schedule import chunks, claim
+from .driver import batch_kernel, chunks
 
 
 @inline
@@ -62,10 +65,11 @@ def motion_workspace(nb, nv):
 
 @inline
 def base_acceleration(grav, a0):
-    """``a0 = [-grav; 0]``: gravity as a fictitious acceleration of the base (RBDA 5.3)."""
+    """``a0 = [-g; 0]``: gravity as a fictitious acceleration of the base (RBDA 5.3); ``grav``
+    is the kernels' ``params`` (gravity at ``GRAVITY``)."""
     for k in range(6):
         a0[k] = 0.0
-    a0[0], a0[1], a0[2] = -grav[0], -grav[1], -grav[2]
+    a0[0], a0[1], a0[2] = -grav[GRAVITY], -grav[GRAVITY + 1], -grav[GRAVITY + 2]
 
 
 @inline
@@ -73,7 +77,7 @@ def motion_step(i, par, dofs, iv, n, axis, R, p, v, a, vel, acc, a0, vJ, t1):
     """Velocity ``vel[i]`` and acceleration ``acc[i]`` of body ``i`` from its parent's (or
     from the base acceleration ``a0`` for a root), ``(R, p)`` its placement in the parent:
     ``v_i = iX_p v_p + S qd``, ``a_i = iX_p a_p + S qdd + v_i x S qd``; ``axis`` >= 0 when
-    ``S = e_axis`` (see ``Model._pack``)."""
+    ``S = e_axis`` (see ``layout.pack``)."""
     if par >= 0:
         motion_act_inv(R, p, vel[par], vel[i])
         motion_act_inv(R, p, acc[par], acc[i])
@@ -91,8 +95,8 @@ def motion_step(i, par, dofs, iv, n, axis, R, p, v, a, vel, acc, a0, vJ, t1):
         vJ[r] = 0.0
     for k in range(iv, iv + n):
         for r in range(6):
-            vJ[r] += dofs[k, r] * v[k]
-            acc[i, r] += dofs[k, r] * a[k]
+            vJ[r] += dofs[k, MOTION + r] * v[k]
+            acc[i, r] += dofs[k, MOTION + r] * a[k]
     for r in range(6):
         vel[i, r] += vJ[r]
     motion_cross(vel[i], vJ, t1)
@@ -106,8 +110,8 @@ def motion_pass(ints, dofs, liR, lip, v, a, grav, vel, acc, vJ, t1, a0):
     base accelerating at ``-grav`` (pass ``grav = 0`` for the true accelerations)."""
     base_acceleration(grav, a0)
     for i in range(ints.shape[0]):
-        motion_step(i, ints[i, 0], dofs, ints[i, 3], ints[i, 4], ints[i, 5], liR[i], lip[i], v, a, vel, acc, a0,
-                    vJ, t1)
+        motion_step(i, ints[i, PARENT], dofs, ints[i, IV], ints[i, NDOF], ints[i, UNIT_AXIS], liR[i], lip[i], v, a,
+                    vel, acc, a0, vJ, t1)
 
 
 @inline
@@ -115,7 +119,7 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
 
     ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
-    Inlined into :func:`rnea_one` (one state) and :func:`rnea_range` (a batch loop, where a
+    Inlined into :func:`rnea_one` (one state) and :func:`rnea_at` (a batch loop, where a
     call per state would cost more than a tenth of the work).
     """
     _, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2 = ws
@@ -127,13 +131,14 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     # Pass 1 (one sweep from the root): placements, motion, body forces
     base_acceleration(params, t2)
     for i in range(nb):
-        par = ints[i, 0]
-        if not body_placement(ints[i, 1], body[i], q, ints[i, 2], liR[i], lip[i], Rj):
+        par = ints[i, PARENT]
+        if not body_placement(ints[i, JTYPE], body[i], q, ints[i, IQ], liR[i], lip[i], Rj):
             return BAD_QUATERNION
         if fcode > 0:
             world_placement(i, par, liR, lip, oR, op)
-        motion_step(i, par, dofs, ints[i, 3], ints[i, 4], ints[i, 5], liR[i], lip[i], v, a, vel, acc, t2, vJ, t1)
-        theta = body[i, 15:25]
+        motion_step(i, par, dofs, ints[i, IV], ints[i, NDOF], ints[i, UNIT_AXIS], liR[i], lip[i], v, a, vel, acc, t2,
+                    vJ, t1)
+        theta = body[i, INERTIA:INERTIA_END]
         inertia_mul(theta, acc[i], f[i])
         force_cross(vel[i], momentum(theta, vel[i]), vJ)
         for r in range(6):
@@ -143,17 +148,17 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
             for r in range(6):
                 f[i, r] -= t1[r]
     # Pass 2: joint torques and forces transmitted to the parents
-    eps = params[3]
+    eps = params[SMOOTHING]
     for i in range(nb - 1, -1, -1):
-        par, iv, n, axis = ints[i, 0], ints[i, 3], ints[i, 4], ints[i, 5]
+        par, iv, n, axis = ints[i, PARENT], ints[i, IV], ints[i, NDOF], ints[i, UNIT_AXIS]
         for k in range(iv, iv + n):
             if axis >= 0:
                 s = f[i, axis]
             else:
                 s = 0.0
                 for r in range(6):
-                    s += dofs[k, r] * f[i, r]
-            tau[k] = s + dofs[k, 6] * a[k] + friction_torque(dofs, eps, v, k)
+                    s += dofs[k, MOTION + r] * f[i, r]
+            tau[k] = s + dofs[k, ARMATURE] * a[k] + friction_torque(dofs, eps, v, k)
         if par >= 0:
             force_act(liR[i], lip[i], f[i], t1)
             for r in range(6):
@@ -167,26 +172,22 @@ def rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     return rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws)
 
 
-@core
-def rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, lo, hi, ws):
-    """:func:`rnea_state` of the states ``lo <= s < hi`` of a batch (``F`` has one row per
-    state, or a single row for all). The views of ``ws`` are rebuilt here, so that the
-    compiler sees their shapes."""
-    ws = (ws[0],) + workspace_views(ws[0], ints.shape[0])
-    for s in range(lo, hi):
-        status[s] = rnea_state(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0],
-                               fcode, check, TAU[s], ws)
+@inline
+def rnea_at(args, s, ws):
+    """:func:`rnea_state` of state ``s`` of a batch (``F`` has one row per state, or a single
+    row for all)."""
+    ints, body, dofs, params, Q, V, A, F, fcode, check, TAU = args
+    return rnea_state(ints, body, dofs, params, Q[s], V[s], A[s], F[s if F.shape[0] > 1 else 0], fcode, check,
+                      TAU[s], ws)
 
 
-@parallel
-def _rnea_batch(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, nchunk):
-    B, counter = Q.shape[0], np.zeros(1, np.int64)
-    for _ in prange(nchunk):
-        ws = workspace(ints.shape[0])
-        lo, hi = claim(counter, B, nchunk)
-        while lo < hi:
-            rnea_range(ints, body, dofs, params, Q, V, A, F, fcode, check, TAU, status, lo, hi, ws)
-            lo, hi = claim(counter, B, nchunk)
+@inline
+def rnea_views(args, ws):
+    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    return (ws[0],) + workspace_views(ws[0], args[0].shape[0])
+
+
+_rnea_batch = batch_kernel(rnea_at, workspace, rnea_views)
 
 
 @kernel
@@ -207,17 +208,17 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
         out=None):
     """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``) into ``out``
     (see ``_inputs.output``); errors name the arrays of ``report`` (default ``x``)."""
-    k = model._kernel
-    dofs, params = k["dofs"][(bool(friction), bool(armature))], k["params"][gravity]
+    k = model.kernel
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[gravity]
     q, v, a = x["q"], x["v"], x["a"]
     tau, result = _inputs.output(out, batch, (model.nv,), x)
     if batch == ():
-        status = _rnea_single(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau)
+        status = _rnea_single(k.ints, k.body, dofs, params, q, v, a, F, fcode, check, tau)
     else:
         status = np.empty(q.shape[0], dtype=np.int64)
-        _rnea_batch(k["ints"], k["body"], dofs, params, q, v, a, F, fcode, check, tau, status,
+        _rnea_batch((k.ints, k.body, dofs, params, q, v, a, F, fcode, check, tau), (model.nbodies,), status,
                     chunks(q.shape[0]))
-    _inputs.raise_for_status(model, status, x if report is None else report, what)
+    raise_for_status(model, status, x if report is None else report, what)
     return result
 
 
@@ -248,10 +249,10 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     friction. Reference: Featherstone, RBDA (2008), Table 5.1.
     """
     if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
-        k = model._kernel  # fast path for one state: the kernel checks sizes and values
+        k = model.kernel  # fast path for one state: the kernel checks sizes and values
         tau = _inputs.fast_out(out, (model.nv,))
         try:
-            if _rnea_packed(k["ints"], k["packed"][friction, armature], q, v, a, check_finite, tau) == OK:
+            if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass

@@ -28,13 +28,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algorithms._inputs import raise_for_status
+from ..algorithms.status import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
 from ..algorithms.regressor import extended_parameters, kinetic_energy_regressor, slotine_li_regressor
 from ..algorithms.rnea import rnea
 from ..algorithms.terms import gravity
-from . import _kernels
+from . import laws
 from .references import PointToPoint, Sampled
 
 
@@ -79,7 +79,7 @@ class Controller:
 
     def kernel_law(self):
         """``(law code, gains (2, nv), breaks, coefs)`` when :func:`robodyn.simulate` can run
-        this controller in compiled code (``simulation._kernels.law_torque``), else None."""
+        this controller in compiled code (``laws.law_torque``), else None."""
         return None
 
 
@@ -134,9 +134,7 @@ class PDGravity(Controller):
     def kernel_law(self):
         if type(self).__call__ is not PDGravity.__call__:
             return None
-        from ..simulation._kernels import PD_GRAVITY
-
-        return PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
+        return laws.PD_GRAVITY, np.stack([self.kp, self.kd]), np.array([0.0, 1.0]), self.q_d.reshape(1, 1, -1).copy()
 
     vectorized = True
 
@@ -195,10 +193,8 @@ class ComputedTorque(Tracking):
         piecewise = getattr(self.reference, "piecewise_polynomial", None)
         if type(self).__call__ is not ComputedTorque.__call__ or piecewise is None:
             return None
-        from ..simulation._kernels import COMPUTED_TORQUE
-
         breaks, coefs = piecewise()
-        return COMPUTED_TORQUE, np.stack([self.kp, self.kd]), breaks, coefs
+        return laws.COMPUTED_TORQUE, np.stack([self.kp, self.kd]), breaks, coefs
 
     def lyapunov(self, t, q, v):
         q_d, v_d, _ = self.reference(t)
@@ -228,10 +224,10 @@ class TaskSpacePD(Controller):
     def position_and_jacobian(self, q):
         """World position (3,) of the frame origin and its linear Jacobian (3, nv) in world
         axes (the rows ``[:3]`` of ``jacobian(model, q, frame, "local_world_aligned")``)."""
-        k = self.model._kernel
+        k = self.model.kernel
         q = np.ascontiguousarray(q, dtype=float)
         J, R, p = np.empty((6, self.model.nv)), np.empty((3, 3)), np.empty(3)
-        status = _kernels.body_jacobian(k["ints"], k["body"], k["dofs"][False, False], q, self._body, J, R, p)
+        status = laws.body_jacobian(k.ints, k.body, k.dofs[False, False], q, self._body, J, R, p)
         raise_for_status(self.model, status, {"q": q}, "TaskSpacePD")
         x = p + R @ self._p
         x_cross = np.array([[0.0, -x[2], x[1]], [x[2], 0.0, -x[0]], [-x[1], x[0], 0.0]])

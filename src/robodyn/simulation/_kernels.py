@@ -19,10 +19,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import inline, kernel
-from ..algorithms._inputs import CHECKED, NO_WRENCH, OK
+from ..layout import IQ, IV, JTYPE
+from ..algorithms.status import CHECKED, NO_WRENCH, OK
+from ..control.laws import law_torque
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
-from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..joints import FREE
 from ..spatial import rotation_from_quaternion
@@ -30,17 +31,11 @@ from ..spatial import rotation_from_quaternion
 SEMI_IMPLICIT_EULER = 0
 RK4 = 1
 
-# Control laws run in compiled code (``robodyn.control`` controllers' ``kernel_law``).
-CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
-PD_GRAVITY = 1       # Kp (q_d - q) - Kd qd + g(q)
-COMPUTED_TORQUE = 2  # rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))
-
-
 @inline
 def chart_point(ints, q0, theta, q):
     """``q = q0 ⊞ theta`` (see the module docstring)."""
     for i in range(ints.shape[0]):
-        jt, iq, iv = ints[i, 1], ints[i, 2], ints[i, 3]
+        jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
         if jt != FREE:
             q[iq] = q0[iq] + theta[iv]
             continue
@@ -63,7 +58,7 @@ def chart_point(ints, q0, theta, q):
 def chart_rate(ints, q, theta, v, R, out):
     """``out = d theta / dt`` for velocity ``v`` at ``q = q0 ⊞ theta``; ``R`` is 3 x 3 workspace."""
     for i in range(ints.shape[0]):
-        jt, iq, iv = ints[i, 1], ints[i, 2], ints[i, 3]
+        jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
         if jt != FREE:
             out[iv] = v[iv]
             continue
@@ -113,59 +108,6 @@ def rate(ints, q, theta, v, R, out):
 def stage(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, tau, thetadot, a, ws, R):
     """Compiled ``derivative`` (with the NaN/Inf check) for the Python-driven integrators."""
     return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, CHECKED, tau, thetadot, a, R, ws)
-
-
-@inline
-def reference_at(breaks, coefs, t, qd, vd, ad):
-    """Piecewise polynomial reference (scipy ``PPoly`` layout: ``coefs[i, seg, j]`` multiplies
-    ``(t - breaks[seg])^(k - 1 - i)``) and its two derivatives at ``t``; outside
-    ``[breaks[0], breaks[-1]]`` it holds its end value at rest."""
-    m, k = breaks.shape[0] - 1, coefs.shape[0]
-    hold = t < breaks[0] or t > breaks[m]
-    if t < breaks[0]:
-        seg, x = 0, 0.0
-    else:
-        lo, hi = 0, m - 1  # the last segment with breaks[seg] <= t
-        while lo < hi:
-            mid = (lo + hi + 1) // 2
-            if breaks[mid] <= t:
-                lo = mid
-            else:
-                hi = mid - 1
-        seg = lo
-        x = min(t, breaks[m]) - breaks[seg]
-    for j in range(coefs.shape[2]):
-        p, dp, ddp = 0.0, 0.0, 0.0
-        for i in range(k):  # Horner's rule with the first two derivatives
-            ddp = ddp * x + 2.0 * dp
-            dp = dp * x + p
-            p = p * x + coefs[i, seg, j]
-        qd[j] = p
-        vd[j] = 0.0 if hold else dp
-        ad[j] = 0.0 if hold else ddp
-
-
-@inline
-def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
-    """The command of a compiled control law at ``(t, q, v)`` into ``out``; returns a status.
-
-    ``c = (ints, body, dofs_gravity, dofs_full, params, zero_wrench)`` of the controller's model
-    (``dofs_gravity`` without friction and armature, ``dofs_full`` with them);
-    ``gains[0] = Kp``, ``gains[1] = Kd``."""
-    if law == CONSTANT:
-        for k in range(out.shape[0]):
-            out[k] = tau_cmd[k]
-        return OK
-    ws, qd, vd, ad, acc, zero = cws
-    reference_at(breaks, coefs, t, qd, vd, ad)
-    if law == PD_GRAVITY:
-        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], NO_WRENCH, CHECKED, out, ws)
-        for k in range(out.shape[0]):
-            out[k] += gains[0, k] * (qd[k] - q[k]) - gains[1, k] * v[k]
-        return st
-    for k in range(out.shape[0]):
-        acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
-    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], NO_WRENCH, CHECKED, out, ws)
 
 
 @kernel

@@ -18,7 +18,8 @@ import time
 import numpy as np
 
 from .. import joints as J
-from ..algorithms._inputs import OK, raise_for_status
+from ..algorithms.status import OK, raise_for_status
+from ..control.laws import CONSTANT
 from . import _kernels as K
 from .trajectory import Trajectory
 
@@ -108,9 +109,9 @@ class _Plant:
     """The model's kernel arrays and the Python-driven stages of the integrators."""
 
     def __init__(self, model):
-        k = model._kernel
+        k = model.kernel
         self.model = model
-        self.args = (k["ints"], k["body"], k["dofs"][True, True], k["params"][True], k["zero_wrench"],
+        self.args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench,
                      np.ascontiguousarray(model.effort_limit))
         self.ws, self.R = K.stage_workspace(model.nbodies, model.nq, model.nv)
 
@@ -207,7 +208,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Z[0] = law.z0
     compiled = None
     if integrator in INTEGRATORS and not law.stateful:
-        compiled = (K.CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
+        compiled = (CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
     if compiled is not None:
         _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
     elif integrator in INTEGRATORS:
@@ -231,10 +232,10 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
     law, cmodel, gains, breaks, coefs = compiled
     model = plant.model
     nv = model.nv
-    if law == K.CONSTANT:
+    if law == CONSTANT:
         cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
-    k = cmodel._kernel
-    c = (k["ints"], k["body"], k["dofs"][False, False], k["dofs"][True, True], k["params"][True], k["zero_wrench"])
+    k = cmodel.kernel
+    c = (k.ints, k.body, k.dofs[False, False], k.dofs[True, True], k.params[True], k.zero_wrench)
     n = Q.shape[0] - 1
     method = K.RK4 if integrator == "rk4" else K.SEMI_IMPLICIT_EULER
     zero = np.zeros(nv)

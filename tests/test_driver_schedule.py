@@ -5,7 +5,7 @@ import pytest
 import numba
 from numba import njit
 
-from robodyn.algorithms._schedule import MIN_CHUNK, chunks, claim
+from robodyn.algorithms.driver import MIN_CHUNK, chunks, claim
 
 
 @njit

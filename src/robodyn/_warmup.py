@@ -1,0 +1,105 @@
+"""Load (or compile) every kernel ahead of time, for services that must answer at once.
+
+``robodyn.warmup()`` (and ``robodyn warmup`` on the command line) runs each public function
+with compiled code once on a small model, single state and batch, fixed and floating base,
+then a short simulation of each kind (uncontrolled, compiled controllers, Python controllers).
+Compiled code is cached on disk, so after the first process this only loads it (about a
+second); on a fresh install the first process compiles everything (about two minutes, see
+``benchmarks/RESULTS.md``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def _algorithm_steps(rd, model, q, v, a):
+    """``(name, call)`` of every public algorithm with compiled kernels, at state ``(q, v, a)``."""
+    last = model.nbodies - 1
+    known = np.arange(model.nv) == model.nv - 1
+    point = rd.PointConstraint(last, np.zeros(3), np.zeros(3))
+    return [
+        ("rnea", lambda: rd.rnea(model, q, v, a)),
+        ("aba", lambda: rd.aba(model, q, v, a)),
+        ("crba", lambda: rd.crba(model, q)),
+        ("coriolis_matrix", lambda: rd.coriolis_matrix(model, q, v)),
+        ("christoffel_symbols", lambda: rd.christoffel_symbols(model, q)),
+        ("gravity", lambda: rd.gravity(model, q)),
+        ("nonlinear_effects", lambda: rd.nonlinear_effects(model, q, v)),
+        ("generalized_momentum", lambda: rd.generalized_momentum(model, q, v)),
+        ("kinetic_energy", lambda: rd.kinetic_energy(model, q, v)),
+        ("potential_energy", lambda: rd.potential_energy(model, q)),
+        ("center_of_mass", lambda: rd.center_of_mass(model, q)),
+        ("com_jacobian", lambda: rd.com_jacobian(model, q)),
+        ("jacobian", lambda: rd.jacobian(model, q, last)),
+        ("jacobian_dot_times_v", lambda: rd.jacobian_dot_times_v(model, q, v, last)),
+        ("forward_kinematics", lambda: rd.forward_kinematics(model, q)),
+        ("frame_pose", lambda: rd.frame_pose(model, q, model.link_names[last])),
+        ("integrate", lambda: rd.integrate(model, q, v)),
+        ("difference", lambda: rd.difference(model, q, q)),
+        ("hybrid_dynamics", lambda: rd.hybrid_dynamics(model, q, v, a, a, known)),
+        ("inverse_mass_matrix", lambda: rd.inverse_mass_matrix(model, q)),
+        ("constrained_dynamics", lambda: rd.constrained_dynamics(model, q, v, a, [point])),
+        ("task_space_inertia", lambda: rd.task_space_inertia(model, q, last, rows="linear")),
+        ("dynamically_consistent_inverse", lambda: rd.dynamically_consistent_inverse(model, q, last, rows="linear")),
+        ("task_space_dynamics", lambda: rd.task_space_dynamics(model, q, v, last, rows="linear")),
+        ("regressor", lambda: rd.regressor(model, q, v, a)),
+        ("slotine_li_regressor", lambda: rd.slotine_li_regressor(model, q, v, v, a)),
+        ("kinetic_energy_regressor", lambda: rd.kinetic_energy_regressor(model, q, v)),
+        ("potential_energy_regressor", lambda: rd.potential_energy_regressor(model, q)),
+    ]
+
+
+def _simulation_steps(rd, model):
+    """``(name, call)`` of short simulations that compile every simulation kernel: the compiled
+    runs (no controller, PD with gravity compensation, computed torque; both fixed-step
+    integrators) and the Python-driven stages (a controller in Python, task-space PD)."""
+    from robodyn import control
+    from robodyn.random import random_configuration
+
+    q0, v0 = random_configuration(model, np.random.default_rng(0)), np.zeros(model.nv)
+    pd = control.PDGravity(model, q0, kp=10.0, kd=2.0)
+    ct = control.ComputedTorque(model, control.PointToPoint(q0, q0, 0.01), kp=10.0, kd=2.0)
+    task = control.TaskSpacePD(model, model.link_names[-1], np.zeros(3), kp=10.0, kd=2.0)
+
+    def python_law(t, q, v):
+        return -v
+
+    run = [("simulate", None, "rk4"), ("simulate (semi-implicit Euler)", None, "semi_implicit_euler"),
+           ("simulate (PDGravity)", pd, "rk4"), ("simulate (ComputedTorque)", ct, "rk4"),
+           ("simulate (Python controller)", python_law, "rk4"), ("simulate (TaskSpacePD)", task, "rk4")]
+    return [(name, lambda c=c, i=i: rd.simulate(model, q0, v0, 0.004, 0.002, c, i, progress=False))
+            for name, c, i in run]
+
+
+def steps():
+    """Every warm-up step as ``(name, call)``, in order: the algorithms on a fixed-base and a
+    floating-base model, one state and a batch of two, then the simulations."""
+    import robodyn as rd
+    from robodyn.random import random_model, random_state
+
+    out = []
+    for floating in (False, True):
+        model = random_model(6, seed=0, floating_base=floating, branching=0.0)
+        for size in ((), (2,)):
+            q, v, a = random_state(model, np.random.default_rng(0), size)
+            label = f"{'floating' if floating else 'fixed'} base, {'batch' if size else 'one state'}"
+            out += [(f"{name} ({label})", call) for name, call in _algorithm_steps(rd, model, q, v, a)]
+    out += _simulation_steps(rd, random_model(6, seed=0, floating_base=False, branching=0.0))
+    return out
+
+
+def warmup(progress=None) -> None:
+    """Compile or load every kernel: each public algorithm (single and batched calls, fixed and
+    floating base) and the simulation kernels.
+
+    ``progress``: None (silent), or a callable ``progress(done, total, name)`` called before
+    each step and once at the end (``name`` empty), e.g. to draw a progress bar.
+    """
+    todo = steps()
+    for k, (name, call) in enumerate(todo):
+        if progress is not None:
+            progress(k, len(todo), name)
+        call()
+    if progress is not None:
+        progress(len(todo), len(todo), "")

@@ -1,0 +1,91 @@
+"""The one batch driver (``algorithms.driver``): results, scheduling, on-disk cache keys, and
+that no algorithm writes its own parallel loop."""
+
+import os
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from robodyn._jit import inline, kernel
+from robodyn.algorithms.driver import batch_kernel, chunks
+
+SRC = pathlib.Path(__file__).resolve().parent.parent / "src" / "robodyn"
+
+
+@inline
+def _affine_at(args, s, ws):
+    """``Y[s] = 2 X[s] + ws[0]``, status -1 for a negative input."""
+    X, Y = args
+    if X[s, 0] < 0.0:
+        return -1
+    for k in range(X.shape[1]):
+        Y[s, k] = 2.0 * X[s, k] + ws[0]
+    return 0
+
+
+@kernel
+def _offset_workspace(n):
+    ws = np.empty(n)
+    ws[:] = 1.0
+    return ws
+
+
+@inline
+def _shifted_views(args, ws):
+    """A ``views`` that hands the state function a different workspace."""
+    return ws[1:]
+
+
+_affine_batch = batch_kernel(_affine_at, _offset_workspace)
+_shifted_batch = batch_kernel(_affine_at, _offset_workspace, _shifted_views)
+
+
+@pytest.mark.parametrize("B", [0, 1, 7, 1000])
+def test_every_state_computed_once_with_its_status(B):
+    rng = np.random.default_rng(B)
+    X = rng.standard_normal((B, 3))
+    Y = np.full((B, 3), np.nan)
+    status = np.full(B, 99, dtype=np.int64)
+    _affine_batch((X, Y), (2,), status, chunks(B))
+    bad = X[:, 0] < 0.0
+    np.testing.assert_array_equal(status, np.where(bad, -1, 0))
+    np.testing.assert_array_equal(Y[~bad], 2.0 * X[~bad] + 1.0)
+    assert np.isnan(Y[bad]).all()  # a failed state writes nothing after its check
+
+
+def test_more_chunks_than_states_and_views():
+    X = np.abs(np.random.default_rng(0).standard_normal((5, 2)))
+    Y = np.empty_like(X)
+    status = np.empty(5, dtype=np.int64)
+    _shifted_batch((X, Y), (3,), status, 64)
+    assert (status == 0).all()
+    np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+
+
+KEY = """
+from robodyn.algorithms import rnea, crba
+for k in (rnea._rnea_batch, crba._crba_batch):
+    print(k._cache._index_key(("sig",), k.targetctx.codegen()))
+"""
+
+
+def test_cache_keys_are_stable_across_processes_and_differ_per_algorithm():
+    """Numba's default key pickles the closed-over dispatchers, different in every process; the
+    driver's key must be the same in a new process (so the on-disk cache hits) and differ
+    between algorithms (so they never load each other's code)."""
+    env = dict(os.environ)
+    runs = [subprocess.run([sys.executable, "-c", KEY], capture_output=True, text=True, check=True, env=env).stdout
+            for _ in range(2)]
+    assert runs[0] == runs[1]
+    rnea_key, crba_key = runs[0].strip().split("\n")
+    assert rnea_key != crba_key
+
+
+def test_no_parallel_loop_outside_the_driver():
+    """Every batch kernel comes from ``driver.batch_kernel``: no other module runs ``prange``."""
+    offenders = [str(p.relative_to(SRC)) for p in SRC.rglob("*.py")
+                 if p.name != "driver.py" and "prange(" in p.read_text()]
+    assert offenders == []

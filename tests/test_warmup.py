@@ -1,0 +1,22 @@
+"""``rd.warmup()``: it reaches every public function with compiled code and reports progress."""
+
+import inspect
+
+import robodyn as rd
+from robodyn import _warmup as W
+
+
+def test_every_public_algorithm_and_the_simulation_are_warmed_up():
+    names = {name.split(" (")[0] for name, _ in W.steps()}
+    functions = {n for n, module in rd._LAZY.items() if not inspect.isclass(getattr(rd, n))}
+    assert functions - names == set()
+    assert "simulate" in names
+
+
+def test_progress_reports_each_step_then_the_end(monkeypatch):
+    calls = []
+    monkeypatch.setattr(W, "steps", lambda: [("a", lambda: calls.append("a")), ("b", lambda: calls.append("b"))])
+    seen = []
+    rd.warmup(progress=lambda done, total, name: seen.append((done, total, name)))
+    assert calls == ["a", "b"]
+    assert seen == [(0, 2, "a"), (1, 2, "b"), (2, 2, "")]
