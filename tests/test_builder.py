@@ -130,26 +130,65 @@ def test_physical_argument():
     (dict(mass=1.0, inertia=np.full((3, 3), np.nan)), "must be finite"),
     (dict(mass=1.0, inertia=np.array([[1, 0.5, 0], [0, 1, 0], [0, 0, 1]])), "not symmetric"),
     (dict(mass=-1.0), "negative mass"),
-    (dict(mass=0.0, inertia=I3), "zero mass with non-zero"),
-    (dict(mass=1.0, inertia=np.diag([0.1, 0.1, 0.3])), "triangle inequality"),
 ])
 def test_bad_link(kw, what):
+    """What no merge can repair is refused when the link is added."""
     b = rd.ModelBuilder(source="s")
     with pytest.raises(rd.ModelError, match=f"s: link 'x': .*{what}"):
         b.add_link("x", **kw)
 
 
-def test_unphysical_link_kept_with_warning_in_warn_mode():
-    b = rd.ModelBuilder(source="s", physical="warn")
+@pytest.mark.parametrize("kw, what", [
+    (dict(mass=0.0, inertia=I3), "zero mass with non-zero"),
+    (dict(mass=1.0, inertia=np.diag([0.1, 0.1, 0.3])), "triangle inequality"),
+    (dict(mass=1.0, inertia=np.diag([1.0, 1.0, -0.1])), "not positive semi-definite"),
+])
+def test_unphysical_body_refused_at_build(kw, what):
+    """A moving body that is not a rigid body is refused, naming the body and the link."""
+    b = rd.ModelBuilder(source="s")
     b.add_link("base")
-    with pytest.warns(rd.RobodynWarning, match=r"s: link 'x': .*triangle inequality.*kept as given"):
-        b.add_link("x", mass=1.0, inertia=np.diag([0.1, 0.1, 0.3]))
-    with pytest.raises(rd.ModelError, match="negative mass"):
-        b.add_link("y", mass=-1.0)
+    b.add_link("x", **kw)
     b.add_joint("j", "revolute", "base", "x")
-    with pytest.warns(rd.RobodynWarning, match="body 'x'"):
-        model = b.build()
-    assert model.inertia[0, 9] == pytest.approx(0.3)
+    with pytest.raises(rd.ModelError, match=f"s: body 'x': .*{what}.*physical='warn'"):
+        b.build()
+
+
+def test_placeholder_links_merged_into_consistent_bodies_load():
+    """As in ANYmal, HyQ, Go1: a massless base link with a tiny inertia welded to the trunk, and a
+    massless foot with an inertia welded to a shank. Each merged body is consistent, so the
+    model loads, with the placeholders' inertias included."""
+    b = rd.ModelBuilder(source="s")
+    b.add_link("base", mass=0.0, inertia=np.diag([0.0, 0.0, 3e-6]))
+    b.add_link("trunk", mass=5.0, inertia=np.diag([0.1, 0.2, 0.25]))
+    b.add_link("shank", mass=0.5, com=(0, 0, -0.1), inertia=np.diag([1e-3, 1e-3, 1e-4]))
+    b.add_link("foot", mass=0.0, inertia=np.diag([1e-6, 1e-6, 1e-6]))
+    b.add_link("world_marker", mass=0.0, inertia=I3)  # the root: welded to the world, never moves
+    b.add_joint("b", "fixed", "base", "trunk")
+    b.add_joint("knee", "revolute", "trunk", "shank")
+    b.add_joint("f", "fixed", "shank", "foot", xyz=(0, 0, -0.2))
+    b.add_joint("w", "fixed", "world_marker", "base")
+    model = b.build()
+    assert model.link_names == ("shank",)
+    floating = b.build(floating_base=True)  # the root link moves now, merged with trunk and base
+    assert floating.link_names == ("world_marker", "shank")
+    np.testing.assert_allclose(floating.inertia[0, 4:], [0.11, 0.0, 0.21, 0.0, 0.0, 0.260003])  # trunk + base + marker
+    assert floating.inertia[1, 9] == pytest.approx(1e-4 + 1e-6)
+
+
+def test_merged_body_failure_names_every_link():
+    b = rd.ModelBuilder(source="robot.urdf")
+    b.add_link("base")
+    b.add_link("thigh", mass=1.0, inertia=np.diag([0.01, 0.01, 0.01]))
+    b.add_link("pad", mass=0.0, inertia=np.diag([0.0, 0.0, 1.0]))  # far too large to merge away
+    b.add_joint("hip", "revolute", "base", "thigh")
+    b.add_joint("p", "fixed", "thigh", "pad")
+    with pytest.raises(rd.ModelError) as e:
+        b.build()
+    message = str(e.value)
+    assert "robot.urdf: body 'thigh' (links 'thigh', 'pad' merged by fixed joints)" in message
+    assert "triangle inequality" in message
+    assert "'thigh': mass 1" in message and "'pad': mass 0" in message
+    assert "zero mass with non-zero first moment or inertia" in message  # what the pad carries alone
 
 
 @pytest.mark.parametrize("kw, what", [

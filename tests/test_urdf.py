@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import functools
+import pathlib
+import re
 import warnings
 
 import numpy as np
@@ -19,11 +21,18 @@ from conftest import assert_names_line, erd_id, example_robot_urdfs, marked_line
 # example-robot-data, compared with Pinocchio
 # ----------------------------------------------------------------------------------------
 
-# Published URDFs whose inertias no rigid body can have (not positive semi-definite, or
-# principal moments violating I1 + I2 >= I3, or zero mass with inertia). robodyn refuses
-# them by default, naming the first such link of the file (the one listed), and loads them
-# with physical="warn". Found by loading every file of the installed example-robot-data.
-UNPHYSICAL = {
+# Published URDFs with a moving body no rigid body can be, even after fixed joints merge its
+# links (inertia not positive semi-definite, or principal moments violating I1 + I2 >= I3).
+# robodyn refuses them by default, naming the first such body and its links with their numbers,
+# and loads them with physical="warn". Found by loading every file of example-robot-data.
+UNPHYSICAL = {  # file -> (body, its first link): bodies no rigid body can be, even merged
+    "romeo_description/urdf/romeo_laas_small.urdf": ("LHipPitch_link", "LHipPitch_link"),
+    "romeo_description/urdf/romeo_small.urdf": ("RShoulderYawLink", "RShoulderYawLink"),
+}
+
+# Files with placeholder links (a massless base or foot with an inertia, a sensor mount) that
+# are not rigid bodies alone, but merge by fixed joints into consistent bodies: they load.
+PLACEHOLDERS = {
     "alex_description/urdf/alex_psyonic_hands.urdf": "LeftPsyonicAbilityBaseLink",
     "allegro_hand_description/urdf/allegro_left_hand.urdf": "link_11.0",
     "allegro_hand_description/urdf/allegro_right_hand.urdf": "link_3.0",
@@ -36,8 +45,6 @@ UNPHYSICAL = {
     "go1_description/urdf/go1.urdf": "base",
     "hyq_description/robots/hyq_no_sensors.urdf": "base_link",
     "pr2_description/urdf/pr2.urdf": "sensor_mount_link",
-    "romeo_description/urdf/romeo_laas_small.urdf": "LShoulderYaw_link",
-    "romeo_description/urdf/romeo_small.urdf": "RShoulderYawLink",
     "tiago_description/robots/tiago.urdf": "base_antenna_left_link",
     "tiago_description/robots/tiago_dual.urdf": "base_antenna_left_link",
     "tiago_description/robots/tiago_no_hand.urdf": "base_antenna_left_link",
@@ -55,7 +62,7 @@ PIN_URDFS = [p for p in ALL_URDFS if erd_id(p) not in PINOCCHIO_REFUSES]
 def test_example_robot_data_is_found():
     assert len(ALL_URDFS) >= 60
     known = {erd_id(p) for p in ALL_URDFS}
-    assert set(UNPHYSICAL) <= known and set(PINOCCHIO_REFUSES) <= known
+    assert set(UNPHYSICAL) <= known and set(PLACEHOLDERS) <= known and set(PINOCCHIO_REFUSES) <= known
 
 
 @functools.lru_cache(maxsize=None)
@@ -138,18 +145,42 @@ def test_example_robot_data_floating_base_matches_pinocchio(path):
 @pytest.mark.parametrize("rel", sorted(UNPHYSICAL))
 def test_unphysical_example_robot_data_refused_then_loaded_with_warning(rel):
     path = next(p for p in ALL_URDFS if erd_id(p) == rel)
-    link = UNPHYSICAL[rel]
+    body, link = UNPHYSICAL[rel]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
         with pytest.raises(rd.ModelError) as err:
             rd.load_urdf(path)
     msg = str(err.value)
-    assert str(path) in msg and f"<link name={link!r}>" in msg and "line " in msg
+    assert str(path) in msg and f"body {body!r}" in msg and f"<link name={link!r}>" in msg and "line " in msg
+    assert "principal moments" in msg and "mass " in msg  # the numbers
     assert "physical='warn'" in msg  # says how to load it anyway
     with pytest.warns(rd.RobodynWarning) as record:
         model = rd.load_urdf(path, physical="warn")
-    assert any(f"<link name={link!r}>" in str(w.message) and "kept as given" in str(w.message) for w in record)
+    assert any(f"body {body!r}" in str(w.message) and "kept as given" in str(w.message) for w in record)
     assert model.physical == "warn"
+
+
+@pytest.mark.parametrize("rel", sorted(PLACEHOLDERS))
+def test_placeholder_links_merge_into_consistent_bodies(rel):
+    """The link is not a rigid body alone (given alone, it is refused), but the body it shares
+    with other links is: the file loads with the defaults, fixed and floating base."""
+    path = next(p for p in ALL_URDFS if erd_id(p) == rel)
+    for floating_base in (False, True):
+        model = _load_quietly(path, floating_base=floating_base)
+        assert model.physical == "error"
+    link = PLACEHOLDERS[rel]
+    b, _, _ = model.frame_index(link)
+    together = [n for n in model.link_names + model.frame_names if model.frame_index(n)[0] == b]
+    assert b >= 0 and len(together) > 1  # merged with another link by a fixed joint
+    text = pathlib.Path(path).read_text()
+    element = re.search(rf'<link\s+name="{re.escape(link)}"\s*>.*?</link>', text, re.S).group(0)
+    alone = f'<robot name="r">{element}<link name="{link}_parent"/><joint name="j" type="revolute">' \
+        f'<parent link="{link}_parent"/><child link="{link}"/><axis xyz="0 0 1"/>' \
+        '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>'
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        with pytest.raises(rd.ModelError, match=f"body {re.escape(repr(link))}"):
+            rd.load_urdf(alone)
 
 
 @pytest.mark.parametrize("rel", sorted(PINOCCHIO_REFUSES))

@@ -44,6 +44,10 @@ kernel = njit(**_CALLED)
 parallel = njit(parallel=True, **_CALLED)
 core = njit(_nrt=False, **_CALLED)
 inline = njit(_nrt=False, **dict(_BASE, forceinline=True))
+# ``splice``: a tiny helper called with many argument types (a workspace's shapes), spliced
+# into each caller's Numba IR (``inline="always"``): cheaper to compile than one machine-code
+# function per argument type.
+splice = njit(_nrt=False, inline="always", **_CALLED)
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
 # carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.
 exact = njit(_nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))

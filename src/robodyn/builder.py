@@ -5,6 +5,14 @@ all without recursion), orders the bodies depth first (children in the order the
 were added, as URDF parsers do), merges fixed joints into their parent body with the
 parallel-axis theorem and keeps every merged link as a frame.
 
+Physical consistency (mass, positive semi-definite inertia about the centre of mass, triangle
+inequality, no inertia without mass) is checked on the bodies the dynamics uses, after the
+merge: a placeholder link (a massless ``base`` with a tiny inertia, a foot frame with an inertia
+and no mass) that a fixed joint merges into a consistent body is fine, as are links welded to
+the world. A body that fails names every link merged into it and what each one carries. Links
+are checked alone only for what no merge can repair: non-finite values, an asymmetric inertia,
+a negative mass.
+
 Example::
 
     b = ModelBuilder("arm")
@@ -44,6 +52,7 @@ class _Link:
     name: str
     theta: np.ndarray
     where: str
+    issue: str = ""  # why the link alone is not a consistent rigid body (checked after merging)
 
 
 @dataclass
@@ -94,21 +103,39 @@ class ModelBuilder:
         if inertia_rotation is not None:
             Rr = np.asarray(inertia_rotation, dtype=float)
             Ic = Rr @ Ic @ Rr.T
+        if mass < 0:
+            raise ModelError(f"{where}: negative mass {mass}")
         theta = inertial_parameters_from(mass, com, Ic)
-        self._check_physical(theta, where)
-        self._links[name] = _Link(name, theta, where)
-
-    def _check_physical(self, theta, where: str) -> None:
-        if self.physical == "warn" and np.all(np.isfinite(theta)) and theta[0] >= 0:
-            try:
-                check_inertial_parameters(theta, where)
-            except ModelError as e:
-                warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=4)
-            return
         try:
             check_inertial_parameters(theta, where)
+            issue = ""
         except ModelError as e:
-            raise ModelError(f"{e} (load with physical='warn' to keep it anyway)") from None
+            issue = str(e)
+        self._links[name] = _Link(name, theta, where, issue)
+
+    def _check_body(self, theta, name: str, links: list[_Link]) -> None:
+        """Check the merged body ``name`` (``theta``), made of ``links``; raise (or warn, with
+        ``physical="warn"``) naming each link and what it carries."""
+        where = f"{self.source}: body {name!r}"
+        if len(links) > 1:
+            where += f" (links {', '.join(repr(k.name) for k in links)} merged by fixed joints)"
+        try:
+            check_inertial_parameters(theta, where)
+            return
+        except ModelError as e:
+            message = str(e)
+        parts = []
+        for k in links:
+            m, h = k.theta[0], k.theta[1:4]
+            com = (h / m).round(6).tolist() if m > 0 else "-"
+            place = k.where[len(self.source) + 2:] if k.where.startswith(f"{self.source}: ") else k.where
+            alone = k.issue[len(k.where) + 2:] if k.issue and len(links) > 1 else ""
+            parts.append(f"{place}: mass {m:.6g}, com {com}" + (f", alone: {alone}" if alone else ""))
+        message += "; made of " + "; ".join(parts)
+        if self.physical == "warn":
+            warnings.warn(f"{message}; kept as given (physical='warn')", RobodynWarning, stacklevel=3)
+        else:
+            raise ModelError(f"{message} (load with physical='warn' to keep it anyway)")
 
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
@@ -235,13 +262,15 @@ class ModelBuilder:
                 place[jt.child] = (nb, np.eye(3), np.zeros(3))
             order.append(jt.child)
             stack.extend(reversed(children[jt.child]))
+        members: list[list[_Link]] = [[] for _ in theta]
         for link in order:
             b, R, p = place[link]
             if b < 0:
                 continue  # carried by the fixed world
             theta[b] += inertial_parameters_in_parent(R, p, self._links[link].theta)
+            members[b].append(self._links[link])
         for i, t in enumerate(theta):
-            self._check_physical(t, f"{self.source}: body {names[i]!r} (with the links merged into it)")
+            self._check_body(t, names[i], members[i])
 
         def col(key):
             return np.array([d[key] for d in dofs], dtype=float)

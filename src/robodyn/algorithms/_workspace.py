@@ -15,7 +15,7 @@ from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
 
-from .._jit import inline
+from .._jit import inline, splice
 
 
 @intrinsic
@@ -46,7 +46,7 @@ def view(typingctx, buf, offset, shape):
     return sig, codegen
 
 
-@inline
+@splice
 def take(buf, o, shape):
     """The view of ``buf[o:o + prod(shape)]`` with ``shape`` (a tuple of ints), and the
     offset after it."""

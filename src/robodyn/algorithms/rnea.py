@@ -201,7 +201,7 @@ def _rnea_packed(ints, packed, q, v, a, check, tau):
     body, dofs, params, zero = unpack(ints, packed)
     if not fits(tau, dofs.shape[0], q, v, a):
         return WRONG_SIZE
-    return rnea_one(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
+    return rnea_state(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
 def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None,
