@@ -87,7 +87,7 @@ def test_bench_compares_with_pinocchio(capsys):
 def test_to_pinocchio_matches(capsys):
     import pinocchio as pin
 
-    from robodyn.bench import to_pinocchio
+    from robodyn.interop import to_pinocchio
     from robodyn.random import random_model, random_state
 
     for floating in (False, True):
@@ -102,7 +102,8 @@ def test_benchmark_agreement_check_sees_a_difference():
     the same robot and large when the Pinocchio model differs by one mass."""
     import pinocchio as pin
 
-    from robodyn.bench import agreement, to_pinocchio
+    from robodyn.bench import agreement
+    from robodyn.interop import to_pinocchio
     from robodyn.random import random_model
 
     # a chain: Pinocchio's CRBA needs the bodies in depth-first order, which a random tree lacks

@@ -153,7 +153,8 @@ def test_unknown_joint(joint):
     (dict(damping=-0.1), "damping must be finite and >= 0"),
 ])
 def test_bad_link_data(kw, what):
-    with pytest.raises(rd.ModelError, match=rf"DH table \(standard\): link 1: .*{what}"):
+    """Refused when added (link 1), or when its body is checked (naming link 1 in it)."""
+    with pytest.raises(rd.ModelError, match=rf"DH table \(standard\): (link 1: .*{what}|body 'link1'.*{what}.*made of link 1)"):
         rd.from_dh([rd.DHLink(a=0.1, alpha=0.0, d=0.0, **kw)])
 
 

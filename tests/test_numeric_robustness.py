@@ -113,7 +113,7 @@ def test_the_cases_span_the_ranges_they_claim():
 
 def _pin_talos_like():
     """A floating-base random tree with mixed masses, converted to Pinocchio."""
-    from robodyn.bench import to_pinocchio
+    from robodyn.interop import to_pinocchio
 
     # parents [-1, 0, 0, 2, 3, 4, 2, 6, 7, 6]: three branch points, in the depth-first order
     # a Pinocchio model needs (``to_pinocchio`` refuses other orders)

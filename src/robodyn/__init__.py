@@ -30,7 +30,7 @@ _LAZY = {
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
-              "plots": None, "identification": None, "symbolic": None}
+              "plots": None, "identification": None, "symbolic": None, "interop": None}
 
 
 def __getattr__(name):
@@ -70,7 +70,7 @@ __all__ = [
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
-    "slotine_li_regressor",
+    "slotine_li_regressor", "interop",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

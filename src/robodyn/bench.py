@@ -3,10 +3,10 @@
 ``robodyn bench [MODEL]`` prints per-call times of single calls (input checks on) and
 per-state times of batched calls, for ``rnea``, ``aba``, ``crba`` and ``coriolis_matrix``.
 When Pinocchio (``pip install pin``) is importable, the model is converted with
-:func:`to_pinocchio` and Pinocchio's Python calls are timed on the same states in the same
+:func:`robodyn.interop.to_pinocchio` and Pinocchio's Python calls are timed on the same states in the same
 process, with the ratio robodyn / Pinocchio (below 1 means robodyn is faster).
 
-Pinocchio is never a runtime dependency: it is imported only here, only when asked for.
+Pinocchio is never a runtime dependency: it is imported only when asked for.
 """
 
 from __future__ import annotations
@@ -17,57 +17,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from . import joints as J
-
-
-def to_pinocchio(model):
-    """The same robot as a Pinocchio model (joint order, placements, inertias, armature).
-
-    Revolute and prismatic joints on a coordinate axis become Pinocchio's RX/RY/RZ/PX/PY/PZ
-    joints, others its unaligned variants; a free joint becomes a free flyer.
-
-    Pinocchio's subtree algorithms (its CRBA) need the bodies in depth-first order; a model
-    in another order (a random tree, say) raises ``ValueError``.
-    """
-    import pinocchio as pin
-
-    for i in range(1, model.nbodies):  # depth-first: the parent of i is i - 1 or one of its ancestors
-        j = i - 1
-        while j >= 0 and j != model.parent[i]:
-            j = model.parent[j]
-        if j != model.parent[i]:
-            raise ValueError(f"to_pinocchio: body {i} ({model.link_names[i]!r}) breaks the depth-first order "
-                             "Pinocchio needs (its parent is not body i - 1 or one of its ancestors)")
-
-    pm = pin.Model()
-    pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float), np.zeros(3))
-    aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
-               J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}
-    unaligned = {J.REVOLUTE: pin.JointModelRevoluteUnaligned, J.PRISMATIC: pin.JointModelPrismaticUnaligned}
-    for i in range(model.nbodies):
-        jt, axis = int(model.joint_type[i]), model.joint_axis[i]
-        if jt == J.FREE:
-            jm = pin.JointModelFreeFlyer()
-        else:
-            k = int(np.argmax(np.abs(axis)))
-            if abs(axis[k]) == 1.0 and axis[k] > 0:
-                jm = aligned[jt][k]()
-            else:
-                jm = unaligned[jt](*axis)
-        placement = pin.SE3(np.asarray(model.X_tree_R[i]), np.asarray(model.X_tree_p[i]))
-        jid = pm.addJoint(int(model.parent[i]) + 1, jm, placement, model.body_joint_names[i])
-        theta = model.inertia[i]
-        m = theta[0]
-        if m > 0:
-            c = theta[1:4] / m
-            Io = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
-            Ic = Io - m * (c @ c * np.eye(3) - np.outer(c, c))
-            inertia = pin.Inertia(m, c, Ic)
-        else:
-            inertia = pin.Inertia.Zero()
-        pm.appendBodyToJoint(jid, inertia, pin.SE3.Identity())
-    pm.armature = np.asarray(model.armature, dtype=float).copy()
-    return pm
+from .interop.pinocchio import to_pinocchio
 
 
 @dataclass

@@ -1,0 +1,338 @@
+"""Pinocchio models to and from robodyn models: :func:`to_pinocchio`, :func:`from_pinocchio`.
+
+Pinocchio (``pip install pin``, version 3 or later; tested with 4.1) is an optional dependency:
+it is imported inside the functions, and a missing Pinocchio raises ``ImportError`` naming
+``pip install pin``.
+
+How the two models correspond (both are trees with parents before children):
+
+- Pinocchio joint ``j`` (``1 <= j < njoints``; joint 0 is the ``universe``) is robodyn body
+  ``i = j - 1``, with ``parent[i] = parents[j] - 1`` (``-1``: the world). The joint order, and
+  hence the ``v``, ``a`` and ``tau`` layouts (``idx_v``), are the same one to one.
+- ``jointPlacements[j]`` is ``(X_tree_R[i], X_tree_p[i])``: the joint frame in the parent
+  joint's (body's) frame; the body frame coincides with the joint frame at ``q = 0``.
+- ``inertias[j]`` is ``inertia[i]``: the inertia of everything rigidly attached to the joint,
+  in the joint (body) frame. Pinocchio's ``Inertia.toDynamicParameters()`` is robodyn's order
+  ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``, about the frame origin. The
+  ``universe``'s inertia (links fixed to the world) carries no dynamics and is not converted.
+- Joint types: robodyn ``revolute`` <-> ``JointModelRX``/``RY``/``RZ`` (axis +x, +y or +z) or
+  ``JointModelRevoluteUnaligned`` (any other axis); ``prismatic`` <-> ``PX``/``PY``/``PZ`` or
+  ``PrismaticUnaligned``; ``free`` <-> ``JointModelFreeFlyer`` (at the root only). Pinocchio's
+  continuous joints ``RUBX``/``RUBY``/``RUBZ``/``RevoluteUnboundedUnaligned`` become unbounded
+  revolute joints (robodyn's continuous joints). Other Pinocchio joints (spherical, planar,
+  translation, universal, helical, composite, ...) and mimic joints raise ``ModelError``.
+- ``q``: a free joint is ``[x, y, z, qx, qy, qz, qw]`` (unit quaternion, scalar last) in both,
+  with ``v = [v_lin, omega]`` in the child (base) frame in both: no conversion. A continuous
+  joint is ``(cos t, sin t)`` (2 entries) in Pinocchio and ``t`` in robodyn:
+  :func:`configuration_to_pinocchio` and :func:`configuration_from_pinocchio` convert.
+  :func:`to_pinocchio` writes no continuous joints, so its ``q`` is robodyn's.
+- Spatial vectors: Pinocchio's ``Motion`` is ``[linear, angular]`` and ``Force``
+  ``[force, torque]``, as robodyn's public arrays.
+- Frames: robodyn's link names are Pinocchio ``BODY`` frames on their joint (identity
+  placement); robodyn's frames (links merged by fixed joints, the fixed base's root link) are
+  ``BODY`` frames too, placed relative to their parent joint; ``OP_FRAME`` and ``SENSOR`` frames
+  also become robodyn frames. ``JOINT`` and ``FIXED_JOINT`` frames are joint names, not
+  frames, in robodyn.
+- Per-dof data (arrays of ``nv``): position limits (1-dof joints), ``velocityLimit``,
+  ``effortLimit``, ``damping``, ``friction`` (Coulomb, robodyn's ``coulomb``) and ``armature``.
+  Unbounded in robodyn is ``+-inf``, in Pinocchio ``+-numpy.finfo(float).max``.
+  Pinocchio's dynamics leave joint friction out; robodyn's add it unless ``friction=False``.
+- Units: SI in both (m, kg, kg m^2, rad, N, N m); gravity ``(3,)`` in the world frame.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from .. import joints as J
+from ..errors import ModelError, RobodynWarning
+from ..model import Model, check_inertial_parameters, inertia_about_origin
+
+# Pinocchio's "unbounded" (the default of its limits) is the largest double.
+_BIG = np.finfo(float).max
+
+_REVOLUTE = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned")
+_CONTINUOUS = ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned")
+_PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
+# Pinocchio joint type -> robodyn joint type
+_FROM_PIN = {**dict.fromkeys(_REVOLUTE + _CONTINUOUS, J.REVOLUTE), **dict.fromkeys(_PRISMATIC, J.PRISMATIC),
+             "JointModelFreeFlyer": J.FREE}
+
+# Symmetric per-dof bounds: robodyn field, Pinocchio's name (the upper bound in Pinocchio >= 4),
+# and the suffix of Pinocchio >= 4's separate lower bound ("lower" + suffix).
+_BOUNDS = (("effort_limit", "effortLimit", "EffortLimit"), ("velocity_limit", "velocityLimit", "VelocityLimit"),
+           ("coulomb", "friction", "DryFrictionLimit"))
+
+
+def _import_pinocchio(caller: str):
+    try:
+        import pinocchio
+    except ImportError as e:
+        raise ImportError(f"{caller} needs Pinocchio, an optional dependency of robodyn: pip install pin") from e
+    return pinocchio
+
+
+def _to_pin_bound(x) -> np.ndarray:
+    return np.clip(np.asarray(x, dtype=float), -_BIG, _BIG)
+
+
+def _from_pin_bound(x) -> np.ndarray:
+    x = np.array(x, dtype=float)
+    x[x >= _BIG], x[x <= -_BIG] = np.inf, -np.inf
+    return x
+
+
+# ---------------------------------------------------------------------------------------
+# robodyn -> Pinocchio
+
+
+def _check_depth_first(model: Model) -> None:
+    """Pinocchio's subtree algorithms (its CRBA) need the bodies in depth-first order."""
+    for i in range(1, model.nbodies):  # the parent of i is i - 1 or one of its ancestors
+        j = i - 1
+        while j >= 0 and j != model.parent[i]:
+            j = model.parent[j]
+        if j != model.parent[i]:
+            raise ValueError(f"to_pinocchio: body {i} ({model.link_names[i]!r}) breaks the depth-first order "
+                             "Pinocchio needs (its parent is not body i - 1 or one of its ancestors)")
+
+
+def _pin_joint(pin, jtype: int, axis: np.ndarray):
+    if jtype == J.FREE:
+        return pin.JointModelFreeFlyer()
+    aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
+               J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}[jtype]
+    k = int(np.argmax(np.abs(axis)))
+    if axis[k] == 1.0:
+        return aligned[k]()
+    unaligned = pin.JointModelRevoluteUnaligned if jtype == J.REVOLUTE else pin.JointModelPrismaticUnaligned
+    return unaligned(*axis)
+
+
+def _pin_inertia(pin, theta: np.ndarray):
+    """Pinocchio's Inertia of robodyn's 10 parameters (the same order); a massless body keeps
+    its rotational inertia (``FromDynamicParameters`` would divide by the mass)."""
+    if theta[0] > 0:
+        return pin.Inertia.FromDynamicParameters(np.asarray(theta, dtype=float))
+    return pin.Inertia(0.0, np.zeros(3), inertia_about_origin(theta))
+
+
+def to_pinocchio(model: Model):
+    """The same robot as a ``pinocchio.Model``: same joints in the same order, same ``q``/``v``.
+
+    Converted: the tree (joint ``j = i + 1`` for body ``i``, named ``model.body_joint_names[i]``),
+    joint placements ``X_tree``, joint types (revolute and prismatic joints on +x, +y or +z
+    become ``JointModelRX``... ``PZ``, other axes the ``Unaligned`` variants, the free joint a
+    ``JointModelFreeFlyer``), body inertias (in the body frame), gravity (world frame), the
+    model name, and per dof: position limits of 1-dof joints, velocity and effort limits,
+    damping, Coulomb friction (Pinocchio's ``friction``) and armature. Frames: a ``JOINT`` frame
+    per joint, a ``BODY`` frame per body named ``model.link_names[i]`` (identity placement on
+    its joint), and a ``BODY`` frame per robodyn frame (``model.frame_names``, placed in its
+    body's frame; on the ``universe`` for the world). ``coulomb_smoothing`` has no Pinocchio
+    counterpart. Conventions and frames: see :mod:`robodyn.interop.pinocchio`; ``q``, ``v``,
+    ``a`` and ``tau`` can be passed unchanged to Pinocchio's functions.
+
+    Pinocchio's subtree algorithms (its CRBA) need the bodies in depth-first order; a model in
+    another order (a random tree, say) raises ``ValueError``. Pinocchio is imported here (an
+    optional dependency); without it this raises ``ImportError`` (``pip install pin``).
+    """
+    pin = _import_pinocchio("to_pinocchio")
+    _check_depth_first(model)
+    pm = pin.Model()
+    pm.name = model.name
+    pm.gravity = pin.Motion(np.asarray(model.gravity, dtype=float), np.zeros(3))
+    body_frame = {-1: 0}  # robodyn body -> Pinocchio frame of its link (the world: "universe")
+    for i in range(model.nbodies):
+        parent = int(model.parent[i])
+        placement = pin.SE3(np.asarray(model.X_tree_R[i]), np.asarray(model.X_tree_p[i]))
+        jid = pm.addJoint(parent + 1, _pin_joint(pin, int(model.joint_type[i]), model.joint_axis[i]),
+                          placement, model.body_joint_names[i])
+        pm.appendBodyToJoint(jid, _pin_inertia(pin, model.inertia[i]), pin.SE3.Identity())
+        joint_frame = pm.addJointFrame(jid, body_frame[parent])
+        body_frame[i] = pm.addBodyFrame(model.link_names[i], jid, pin.SE3.Identity(), joint_frame)
+    for name, b, R, p in zip(model.frame_names, model.frame_body, model.frame_R, model.frame_p):
+        frame = pin.Frame(name, int(b) + 1, body_frame[int(b)], pin.SE3(np.asarray(R), np.asarray(p)),
+                          pin.FrameType.BODY)
+        pm.addFrame(frame, False)
+
+    one_dof = model.joint_type != J.FREE  # free joints keep Pinocchio's default (unbounded) limits
+    lower, upper = pm.lowerPositionLimit.copy(), pm.upperPositionLimit.copy()
+    lower[model.idx_q[one_dof]] = _to_pin_bound(model.lower[model.idx_v[one_dof]])
+    upper[model.idx_q[one_dof]] = _to_pin_bound(model.upper[model.idx_v[one_dof]])
+    pm.lowerPositionLimit, pm.upperPositionLimit = lower, upper
+    for field, name, suffix in _BOUNDS:
+        bound = _to_pin_bound(getattr(model, field))
+        setattr(pm, name, bound)
+        if hasattr(pm, "lower" + suffix):  # Pinocchio >= 4: a separate lower bound
+            setattr(pm, "lower" + suffix, -bound)
+    pm.damping = np.asarray(model.damping, dtype=float).copy()
+    pm.armature = np.asarray(model.armature, dtype=float).copy()
+    return pm
+
+
+# ---------------------------------------------------------------------------------------
+# Pinocchio -> robodyn
+
+
+def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray]:
+    """robodyn's joint type and axis (child frame) of Pinocchio joint ``j``, or ModelError."""
+    jm, name = pm.joints[j], pm.names[j]
+    kind = jm.shortname()
+    if kind == "JointModelMimic":
+        mimicked = [pm.names[m] for k, m in zip(pm.mimicking_joints, pm.mimicked_joints) if k == j]
+        raise ModelError(
+            f"{source}: joint {name!r} is a mimic joint (JointModelMimic of {', '.join(map(repr, mimicked))}), "
+            "which robodyn does not represent; build the Pinocchio model without mimic joints "
+            "(buildModelFromUrdf(..., mimic=False)) and couple the joints with rd.CouplingConstraint")
+    if kind not in _FROM_PIN:
+        raise ModelError(
+            f"{source}: joint {name!r} is a {kind} ({jm.nq} q, {jm.nv} v), which robodyn cannot represent; "
+            f"supported Pinocchio joints: {', '.join(_FROM_PIN)}")
+    jtype = _FROM_PIN[kind]
+    if jtype == J.FREE:
+        if pm.parents[j] != 0:
+            raise ModelError(f"{source}: joint {name!r} is a JointModelFreeFlyer below joint "
+                             f"{pm.names[pm.parents[j]]!r}; robodyn's free joint must attach to the world")
+        return jtype, np.zeros(3)
+    S = np.asarray(jm.createData().S, dtype=float).reshape(6)  # constant, [linear; angular]
+    return jtype, (S[3:] if jtype == J.REVOLUTE else S[:3])
+
+
+def _link_names_and_frames(pin, pm):
+    """The name of each body (its joint's first ``BODY`` frame with identity placement, else the
+    joint's name) and the other ``BODY``/``OP_FRAME``/``SENSOR`` frames as
+    ``(name, body, R, p)`` with the placement in the body frame (``body = -1``: the world)."""
+    link_frame = {}  # Pinocchio joint -> index of the frame that names its body
+    for k, f in enumerate(pm.frames):
+        if f.type == pin.FrameType.BODY and f.parentJoint > 0 and f.parentJoint not in link_frame \
+                and f.placement.isIdentity():
+            link_frame[f.parentJoint] = k
+    names = [pm.frames[link_frame[j]].name if j in link_frame else pm.names[j] for j in range(1, pm.njoints)]
+    kept = (pin.FrameType.BODY, pin.FrameType.OP_FRAME, pin.FrameType.SENSOR)
+    taken = set(link_frame.values())
+    frames = [(f.name, f.parentJoint - 1, f.placement.rotation, f.placement.translation)
+              for k, f in enumerate(pm.frames) if f.type in kept and k not in taken]
+    return names, frames
+
+
+def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
+    """The robodyn :class:`~robodyn.model.Model` of a ``pinocchio.Model``, joints in the same order.
+
+    Converted: the tree (body ``i`` for Pinocchio joint ``j = i + 1``, joint named
+    ``pin_model.names[j]``), ``jointPlacements``, joint types (``RX``/``RY``/``RZ`` and
+    ``RevoluteUnaligned`` -> revolute; ``RUBX``/``RUBY``/``RUBZ`` and
+    ``RevoluteUnboundedUnaligned`` -> unbounded revolute, i.e. robodyn's continuous joint with one
+    angle instead of ``(cos, sin)``; ``PX``/``PY``/``PZ`` and ``PrismaticUnaligned`` ->
+    prismatic; ``FreeFlyer`` at the root -> free joint, same ``q``/``v`` layout), ``inertias``,
+    gravity (linear part), the model name, and per dof: position limits of 1-dof joints,
+    ``velocityLimit``, ``effortLimit``, ``damping``, ``friction`` (Coulomb) and ``armature``
+    (Pinocchio's ``+-max double`` becomes ``+-inf``). Bodies are named after their link (the
+    joint's first ``BODY`` frame with identity placement; the joint name if there is none);
+    the other ``BODY``, ``OP_FRAME`` and ``SENSOR`` frames become ``model.frame_names``.
+    Conventions and frames: see :mod:`robodyn.interop.pinocchio`; ``v``, ``a`` and ``tau`` are
+    the same vectors in both, ``q`` too unless the model has continuous joints
+    (:func:`configuration_from_pinocchio`).
+
+    The Pinocchio order is kept as it is (``ModelBuilder`` would reorder a tree depth first).
+    ``physical="error"`` rejects bodies whose inertia no rigid body can have (``ModelError``),
+    ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, as ``load_urdf``.
+
+    Raises ``ModelError`` naming the joint for joint types robodyn has no counterpart of
+    (spherical, planar, translation, universal, helical, composite, ...), mimic joints and
+    free flyers below the root. ``rotorInertia`` and ``rotorGearRatio`` (not used by
+    Pinocchio's dynamics, which use ``armature``) are not converted: a non-zero
+    ``rotorInertia`` is reported by a warning.
+    """
+    pin = _import_pinocchio("from_pinocchio")
+    if not isinstance(pin_model, pin.Model):
+        raise TypeError(f"from_pinocchio: expected a pinocchio.Model, got {type(pin_model).__name__}")
+    if physical not in ("error", "warn"):
+        raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+    pm = pin_model
+    source = f"from_pinocchio(model {pm.name!r})"
+    joints = range(1, pm.njoints)
+    jtype, axis = zip(*(_joint_type_and_axis(pm, j, source) for j in joints)) if pm.njoints > 1 else ((), ())
+    names, frames = _link_names_and_frames(pin, pm)
+    theta = np.reshape([pm.inertias[j].toDynamicParameters() for j in joints], (len(joints), 10))
+    for i, t in enumerate(theta):
+        try:
+            check_inertial_parameters(t, f"{source}: body {i} ({names[i]!r}, joint {pm.names[i + 1]!r})")
+        except ModelError as e:
+            if physical == "error":
+                raise ModelError(f"{e} (convert with physical='warn' to keep it anyway)") from None
+            warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=2)
+
+    # position limits: the q entry of each bounded 1-dof joint (continuous and free: unbounded)
+    lower, upper = np.full(pm.nv, -np.inf), np.full(pm.nv, np.inf)
+    q_lower, q_upper = _from_pin_bound(pm.lowerPositionLimit), _from_pin_bound(pm.upperPositionLimit)
+    for jm in (pm.joints[j] for j in joints if pm.joints[j].shortname() in _REVOLUTE + _PRISMATIC):
+        lower[jm.idx_v], upper[jm.idx_v] = q_lower[jm.idx_q], q_upper[jm.idx_q]
+    dofs = {field: _from_pin_bound(getattr(pm, name)) for field, name, _ in _BOUNDS}
+    if np.any(np.asarray(pm.rotorInertia) != 0):
+        warnings.warn(f"{source}: rotorInertia {np.asarray(pm.rotorInertia).tolist()} not converted "
+                      "(Pinocchio's dynamics use armature; add rotorInertia * rotorGearRatio**2 to the "
+                      "armature if that is the reflected inertia you mean)", RobodynWarning, stacklevel=2)
+    gravity = pm.gravity
+    if np.any(gravity.angular != 0):
+        warnings.warn(f"{source}: angular part {gravity.angular.tolist()} of gravity ignored",
+                      RobodynWarning, stacklevel=2)
+    return Model(
+        parent=[pm.parents[j] - 1 for j in joints], joint_type=jtype, joint_axis=np.reshape(axis, (-1, 3)),
+        X_tree_R=np.reshape([pm.jointPlacements[j].rotation for j in joints], (-1, 3, 3)),
+        X_tree_p=np.reshape([pm.jointPlacements[j].translation for j in joints], (-1, 3)),
+        inertia=theta, link_names=names, body_joint_names=[pm.names[j] for j in joints],
+        gravity=gravity.linear, lower=lower, upper=upper, damping=pm.damping, armature=pm.armature,
+        frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
+        frame_R=np.reshape([f[2] for f in frames], (-1, 3, 3)), frame_p=np.reshape([f[3] for f in frames], (-1, 3)),
+        name=pm.name, physical=physical, **dofs,
+    )
+
+
+# ---------------------------------------------------------------------------------------
+# configurations
+
+
+def _continuous_q(pin_model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``keep``: the Pinocchio q index of each robodyn q entry; ``rd_idx`` and ``pin_idx``: the
+    robodyn q index (the angle) and the Pinocchio q index (``cos``; ``sin`` follows) of each
+    continuous joint."""
+    keep, rd_idx, pin_idx = [], [], []
+    for j in range(1, pin_model.njoints):
+        jm = pin_model.joints[j]
+        if jm.shortname() in _CONTINUOUS:
+            rd_idx.append(len(keep))
+            pin_idx.append(jm.idx_q)
+            keep.append(jm.idx_q)
+        else:
+            keep.extend(range(jm.idx_q, jm.idx_q + jm.nq))
+    return np.array(keep, dtype=np.int64), np.array(rd_idx, dtype=np.int64), np.array(pin_idx, dtype=np.int64)
+
+
+def configuration_to_pinocchio(pin_model, q) -> np.ndarray:
+    """Pinocchio's configuration ``(..., pin_model.nq)`` of robodyn's ``q`` ``(..., nq)`` for
+    the model ``from_pinocchio(pin_model)``: each continuous joint's angle ``t`` becomes
+    ``(cos t, sin t)``; every other entry is copied (free joints: same quaternion layout)."""
+    keep, rd_idx, pin_idx = _continuous_q(pin_model)
+    q = np.asarray(q, dtype=float)
+    if q.ndim < 1 or q.shape[-1] != keep.size:
+        raise ValueError(f"q: expected shape (..., {keep.size}), got {q.shape}")
+    out = np.empty(q.shape[:-1] + (pin_model.nq,))
+    out[..., keep] = q
+    out[..., pin_idx + 1] = np.sin(q[..., rd_idx])
+    out[..., pin_idx] = np.cos(q[..., rd_idx])
+    return out
+
+
+def configuration_from_pinocchio(pin_model, q_pin) -> np.ndarray:
+    """robodyn's ``q`` ``(..., nq)`` of Pinocchio's configuration ``(..., pin_model.nq)`` for
+    the model ``from_pinocchio(pin_model)``: each continuous joint's ``(cos t, sin t)`` becomes
+    ``t = atan2(sin, cos)`` in ``(-pi, pi]``; every other entry is copied."""
+    keep, rd_idx, pin_idx = _continuous_q(pin_model)
+    q_pin = np.asarray(q_pin, dtype=float)
+    if q_pin.ndim < 1 or q_pin.shape[-1] != pin_model.nq:
+        raise ValueError(f"q_pin: expected shape (..., {pin_model.nq}), got {q_pin.shape}")
+    q = q_pin[..., keep]
+    q[..., rd_idx] = np.arctan2(q_pin[..., pin_idx + 1], q_pin[..., pin_idx])
+    return q
