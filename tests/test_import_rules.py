@@ -1,0 +1,87 @@
+"""How the modules of ``src/robodyn`` may import each other (ARCHITECTURE.md): no private name
+from another file, private modules only inside their own package."""
+
+import ast
+import pathlib
+
+import pytest
+
+SRC = pathlib.Path(__file__).resolve().parent.parent / "src"
+PACKAGE = SRC / "robodyn"
+
+
+def module_name(path: pathlib.Path) -> str:
+    parts = list(path.relative_to(SRC).with_suffix("").parts)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+def imports(path: pathlib.Path):
+    """``(line, module, names)`` of every import in the file, anywhere (function bodies too),
+    relative imports resolved."""
+    tree = ast.parse(path.read_text(), str(path))
+    here = module_name(path)
+    package = here if path.name == "__init__.py" else here.rpartition(".")[0]
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield node.lineno, alias.name, []
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")
+                base = base[:len(base) - (node.level - 1)]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module
+            yield node.lineno, module, [a.name for a in node.names]
+
+
+def private(segment: str) -> bool:
+    return segment.startswith("_") and not segment.startswith("__")
+
+
+def is_module(name: str) -> bool:
+    path = SRC.joinpath(*name.split("."))
+    return path.with_suffix(".py").exists() or (path / "__init__.py").exists()
+
+
+FILES = sorted(PACKAGE.rglob("*.py"))
+
+
+def violations(path):
+    here = module_name(path)
+    found = []
+    for line, module, names in imports(path):
+        if not module or not module.startswith("robodyn"):
+            continue
+        targets = [module] + [f"{module}.{n}" for n in names if is_module(f"{module}.{n}")]
+        for target in targets:
+            parts = target.split(".")
+            for k, segment in enumerate(parts):
+                if private(segment):
+                    owner = ".".join(parts[:k])  # the package the private module belongs to
+                    if not (here == owner or here.startswith(owner + ".")):
+                        found.append(f"{here}:{line}: imports {target}, private to {owner}")
+                    break
+        for n in names:
+            if private(n) and not is_module(f"{module}.{n}"):
+                found.append(f"{here}:{line}: imports the private name {n} from {module}")
+    return found
+
+
+def test_rules_catch_what_they_should(tmp_path, monkeypatch):
+    """The checker itself: a private name and a private module of another package are caught."""
+    pkg = tmp_path / "robodyn"
+    (pkg / "a").mkdir(parents=True)
+    (pkg / "b").mkdir()
+    for f in ("__init__.py", "a/__init__.py", "b/__init__.py", "a/_hidden.py", "a/one.py"):
+        (pkg / f).write_text("")
+    (pkg / "a" / "two.py").write_text("from ._hidden import x\nfrom .one import _secret\n")
+    (pkg / "b" / "three.py").write_text("def f():\n    from ..a import _hidden\n")
+    monkeypatch.setattr(__import__(__name__), "SRC", tmp_path)
+    assert violations(pkg / "a" / "two.py") == ["robodyn.a.two:2: imports the private name _secret from robodyn.a.one"]
+    assert violations(pkg / "b" / "three.py") == ["robodyn.b.three:2: imports robodyn.a._hidden, private to robodyn.a"]
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_no_private_import_across_packages(path):
+    assert violations(path) == []
