@@ -1,14 +1,16 @@
-"""The command line: info, demo and bench on built-in robots and URDF files, and its errors."""
+"""The command line: info, demo, bench and warmup on built-in robots and URDF files, and its errors."""
 
 from __future__ import annotations
 
 import re
+import sys
 
 import numpy as np
 import pytest
 
 import robodyn as rd
-from robodyn.cli import main, sample_state
+from robodyn.cli import main
+from robodyn.cli.model import sample_state
 
 
 def run(capsys, *argv):
@@ -150,3 +152,20 @@ def test_output_piped_into_a_reader_that_stops_early_exits_quietly():
     err = proc.stderr.read().decode()
     assert proc.wait(timeout=300) == 0, err
     assert "Traceback" not in err
+
+
+def test_warmup_compiles_every_step_and_draws_a_bar_on_a_terminal(capsys, monkeypatch):
+    """``robodyn warmup``: every step of ``robodyn._warmup.steps()`` runs; on a terminal a
+    progress bar goes to stderr."""
+    from robodyn import _warmup
+
+    total = len(_warmup.steps())
+    code, out, err = run(capsys, "warmup")
+    assert code == 0
+    assert f"robodyn warmup: {total} steps compiled or loaded from the cache in" in out
+    assert err == ""  # not a terminal: no bar
+    monkeypatch.setattr(_warmup, "steps", lambda: [("a", lambda: None), ("b", lambda: None)])
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
+    code, out, err = run(capsys, "warmup")
+    assert code == 0 and "2 steps" in out
+    assert "[" + "#" * 30 + "] 100%" in err

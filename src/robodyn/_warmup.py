@@ -54,8 +54,8 @@ def _simulation_steps(rd, model):
     """``(name, call)`` of short simulations that compile every simulation kernel: the compiled
     runs (no controller, PD with gravity compensation, computed torque; both fixed-step
     integrators) and the Python-driven stages (a controller in Python, task-space PD)."""
-    from robodyn import control
-    from robodyn.random import random_configuration
+    from . import control
+    from .random import random_configuration
 
     q0, v0 = random_configuration(model, np.random.default_rng(0)), np.zeros(model.nv)
     pd = control.PDGravity(model, q0, kp=10.0, kd=2.0)
@@ -72,11 +72,28 @@ def _simulation_steps(rd, model):
             for name, c, i in run]
 
 
+def _public():
+    """The public functions and classes used here, by their names in ``robodyn``."""
+    from types import SimpleNamespace
+
+    from . import random
+    from .algorithms import (aba, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian,
+                             kinematics, minv, regressor, rnea, task_space, terms)
+    from .simulation import simulate
+
+    names = {}
+    for module in (aba, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian, kinematics, minv,
+                   regressor, rnea, task_space, terms):
+        names.update({n: getattr(module, n) for n in dir(module) if not n.startswith("_")})
+    return SimpleNamespace(**names, simulate=simulate, random=random)
+
+
 def steps():
     """Every warm-up step as ``(name, call)``, in order: the algorithms on a fixed-base and a
     floating-base model, one state and a batch of two, then the simulations."""
-    import robodyn as rd
-    from robodyn.random import random_model, random_state
+    from .random import random_model, random_state
+
+    rd = _public()
 
     out = []
     for floating in (False, True):

@@ -214,3 +214,10 @@ class TrigRing(VectorAlgebra):
     def coefficient(self, p, j: int, which: str = "qdd"):
         """The coefficient of ``qdd_j`` (or ``qd_j``) in ``p``, which is linear in it."""
         return p.diff(self.qdd[j] if which == "qdd" else self.qd[j])
+
+
+def readable_numbers(e: sp.Expr) -> sp.Expr:
+    """Rationals with denominators above 10^6 (the exact values of decimal model data such as
+    ``1/12 * 10`` written as ``0.8333333333333334``) as floats, for display."""
+    reps = {r: sp.Float(r, 16) for r in e.atoms(sp.Rational) if r.q > 10**6}
+    return e.xreplace(reps) if reps else e

@@ -32,7 +32,7 @@ import sympy as sp
 from sympy.simplify.fu import TR10i
 
 from . import codegen, lagrange, newton_euler
-from ._ring import TrigRing
+from ._ring import TrigRing, readable_numbers
 from ._terms import GeneratedCode, check_form, check_term, signature
 from .model import SymbolicModel, from_model
 from .recursive import RECURSIONS, recursive_program
@@ -41,13 +41,6 @@ METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
 # Expressions with at most this many terms are rewritten with the angle-sum rules.
 TRIG_TERMS = 16
 
-
-
-def readable_numbers(e: sp.Expr) -> sp.Expr:
-    """Rationals with denominators above 10^6 (the exact values of decimal model data such as
-    ``1/12 * 10`` written as ``0.8333333333333334``) as floats, for display."""
-    reps = {r: sp.Float(r, 16) for r in e.atoms(sp.Rational) if r.q > 10**6}
-    return e.xreplace(reps) if reps else e
 
 
 def christoffel_matrix(rg: TrigRing, M) -> list:
@@ -172,6 +165,17 @@ class EquationsOfMotion(GeneratedCode):
     def L(self) -> sp.Expr:
         """Lagrangian ``T - U``."""
         return self._shaped("L")
+
+    @property
+    def ring(self) -> TrigRing:
+        """The polynomial ring of the terms (trigonometric names, symbols, revolute flags)."""
+        return self._rg
+
+    @property
+    def polynomials(self) -> dict:
+        """The terms as polynomials of :attr:`ring`: ``"M"``, ``"C"`` (lists of rows), ``"g"``,
+        ``"tau"`` (lists), ``"T"``, ``"U"`` (one polynomial each)."""
+        return self._poly
 
     def term(self, name: str):
         """A term by name: ``"M"``, ``"C"``, ``"C_qd"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ._ring import readable_numbers
+
 _DESCRIPTION = {
     "M": "Mass matrix $M(q)$",
     "C": r"Christoffel matrix $C(q, \dot q)$ ($\dot M - 2C$ is skew-symmetric)",
@@ -28,20 +30,19 @@ def _names(eom) -> dict:
         names[eom.q[k]] = f"q_{{{k + 1}}}"
         names[eom.qd[k]] = rf"\dot{{q}}_{{{k + 1}}}"
         names[eom.qdd[k]] = rf"\ddot{{q}}_{{{k + 1}}}"
-        s, c = eom._rg.trig_names(k)
+        s, c = eom.ring.trig_names(k)
         names[s], names[c] = f"s_{{{k + 1}}}", f"c_{{{k + 1}}}"
     return names
 
 
 def _tex(eom, e) -> str:
-    from .equations import readable_numbers
 
     return sp.latex(readable_numbers(e), symbol_names=_names(eom))
 
 
 def _entries(eom, name: str) -> list[tuple[str, sp.Expr]]:
-    p = eom._poly[name]
-    rg = eom._rg
+    p = eom.polynomials[name]
+    rg = eom.ring
     lhs = _LHS[name]
     if name in ("M", "C"):
         return [(f"{lhs}_{{{i + 1}{j + 1}}}", rg.expr(p[i][j], "symbols"))
@@ -64,7 +65,7 @@ def document(eom) -> str:
     joints = ", ".join(f"{n} ({t})" for n, t in zip(m.joint_names, m.joint_type))
     params = ", ".join(f"${sp.latex(s)}$" for s in eom.parameters) or "none (numeric model)"
     notation = ", ".join(f"$s_{{{k + 1}}} = \\sin q_{{{k + 1}}}$, $c_{{{k + 1}}} = \\cos q_{{{k + 1}}}$"
-                         for k in range(eom.n) if eom._rg.revolute[k])
+                         for k in range(eom.n) if eom.ring.revolute[k])
     parts = [
         r"\documentclass[10pt]{article}",
         r"\usepackage{amsmath}",

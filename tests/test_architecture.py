@@ -1,5 +1,5 @@
-"""How the modules of ``src/robodyn`` may import each other (ARCHITECTURE.md): no private name
-from another file, private modules only inside their own package."""
+"""How the modules of ``src/robodyn`` may import each other (ARCHITECTURE.md): no import cycle,
+no private name from another file, private modules only inside their own package."""
 
 import ast
 import pathlib
@@ -85,3 +85,58 @@ def test_rules_catch_what_they_should(tmp_path, monkeypatch):
 @pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_no_private_import_across_packages(path):
     assert violations(path) == []
+
+
+def import_graph(files):
+    """``module -> set of modules it imports`` within ``robodyn``: every ``import`` statement,
+    function bodies included; ``from pkg import name`` is an edge to ``pkg.name`` when that is a
+    module, else to ``pkg``. The packages above an imported module are not counted (Python runs
+    their ``__init__`` first, but a package's own ``__init__`` imports are its edges)."""
+    graph = {}
+    for path in files:
+        here = module_name(path)
+        edges = graph.setdefault(here, set())
+        for _, module, names in imports(path):
+            if not module or not (module == "robodyn" or module.startswith("robodyn.")):
+                continue
+            targets = [f"{module}.{n}" for n in names if is_module(f"{module}.{n}")]
+            if not targets or len(targets) < len(names):
+                targets.append(module)
+            edges.update(t for t in targets if t != here)
+    return graph
+
+
+def find_cycle(graph):
+    """One cycle of ``graph`` as a list of modules (first == last), or None."""
+    state, stack = {}, []
+
+    def visit(node):
+        state[node] = "open"
+        stack.append(node)
+        for nxt in sorted(graph.get(node, ())):
+            if state.get(nxt) == "open":
+                return stack[stack.index(nxt):] + [nxt]
+            if nxt not in state:
+                found = visit(nxt)
+                if found:
+                    return found
+        state[node] = "done"
+        stack.pop()
+        return None
+
+    for node in sorted(graph):
+        if node not in state:
+            found = visit(node)
+            if found:
+                return found
+    return None
+
+
+def test_cycle_finder_finds_a_cycle():
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+def test_no_import_cycle():
+    cycle = find_cycle(import_graph(FILES))
+    assert cycle is None, "import cycle: " + " -> ".join(cycle)

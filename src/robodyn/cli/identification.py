@@ -10,18 +10,18 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .common import add_model_arguments, load_model
+
 
 def _model(args):
-    from ..cli import load_model
-
     if args.model is None:
         raise ValueError(f"robodyn {args.command}: give a MODEL (built-in name or URDF path)")
     return load_model(args.model, args.floating_base, args.physical)
 
 
 def cmd_excite(args) -> int:
-    from .base import base_parameters
-    from .excitation import limits_of, optimize_excitation, write_excitation
+    from ..identification.base import base_parameters
+    from ..identification.excitation import limits_of, optimize_excitation, write_excitation
 
     model = _model(args)
     base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction)
@@ -40,10 +40,10 @@ def cmd_excite(args) -> int:
 
 def cmd_identify(args) -> int:
     from ..io.urdf_writer import write_urdf
-    from .base import base_parameters
-    from .data import preprocess, read_log
-    from .identify import identify
-    from .report import write_report
+    from ..identification.base import base_parameters
+    from ..identification.data import preprocess, read_log
+    from ..identification.identify import identify
+    from ..identification.report import write_report
 
     model = _model(args)
     log = preprocess(read_log(args.data, model), cutoff=args.cutoff, decimate=args.decimate)
@@ -59,11 +59,10 @@ def cmd_identify(args) -> int:
     return 0
 
 
-def add_commands(sub, common) -> None:
-    """Register ``excite`` and ``identify`` on the subparsers of ``robodyn``; ``common(p)``
-    adds the model argument and the loader options."""
+def add_commands(sub) -> None:
+    """Register ``excite`` and ``identify`` on the subparsers of ``robodyn``."""
     p = sub.add_parser("excite", help="optimised excitation trajectory for identification (CSV + PNG)")
-    common(p)
+    add_model_arguments(p)
     p.add_argument("--duration", type=float, default=10.0, help="length of the CSV trajectory (s)")
     p.add_argument("--out", type=Path, required=True, help="CSV file; the plot goes next to it (.png)")
     p.add_argument("--period", type=float, default=None, help="period of the Fourier series (default: duration)")
@@ -76,7 +75,7 @@ def add_commands(sub, common) -> None:
     p.add_argument("--no-friction", action="store_true", help="no viscous/Coulomb friction columns")
     p.set_defaults(func=cmd_excite)
     p = sub.add_parser("identify", help="identify inertial parameters and friction from a CSV log")
-    common(p)
+    add_model_arguments(p)
     p.add_argument("data", type=Path, help="CSV log: time, q_<joint>, [qd_<joint>, qdd_<joint>,] tau_<joint>")
     p.add_argument("--method", choices=("ols", "wls", "physical"), default="ols")
     p.add_argument("--out", type=Path, help="identified model as URDF")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .equations import equations_of_motion
+from .common import add_model_arguments, load_model
 
 
 def run_derive(model, args) -> int:
@@ -14,13 +14,15 @@ def run_derive(model, args) -> int:
     auto``: ``M``, ``g``, ``tau`` as the straight-line code of the recursions, ``C``
     expanded; ``--form expanded``: every term expanded; see
     :meth:`.EquationsOfMotion.program`)."""
+    from ..symbolic.equations import equations_of_motion  # imports sympy
+
     t0 = time.perf_counter()
     eom = equations_of_motion(model, method=args.method)
     t1 = time.perf_counter()
     print(f"robodyn derive {model.name!r}: {eom.n} joints, {args.method.replace('_', '-')} method, "
           f"derived in {t1 - t0:.2f} s")
     sizes = {name: sum(len(x) for row in p for x in (row if isinstance(row, list) else [row]))
-             if isinstance(p, list) else len(p) for name, p in eom._poly.items()}
+             if isinstance(p, list) else len(p) for name, p in eom.polynomials.items()}
     print("  terms (monomials): " + ", ".join(f"{k} {sizes[k]}" for k in ("M", "C", "g", "T", "U", "tau")))
     if eom.n <= 3:
         for name in ("M", "C", "g"):
@@ -35,3 +37,20 @@ def run_derive(model, args) -> int:
         print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)} ({how})")
     sys.stdout.flush()
     return 0
+
+
+def cmd_derive(args) -> int:
+    return run_derive(load_model(args.model, args.floating_base, args.physical), args)
+
+
+def add_commands(sub) -> None:
+    """Register ``derive`` on the ``robodyn`` subcommand parser."""
+    p = sub.add_parser("derive", help="closed-form equations of motion: LaTeX and C code")
+    add_model_arguments(p)
+    p.add_argument("--method", choices=("lagrange", "newton_euler"), default="lagrange")
+    p.add_argument("--latex", metavar="FILE", help="write a LaTeX document of every term")
+    p.add_argument("--c", metavar="DIR", dest="c_dir", help="write C source and header into DIR")
+    p.add_argument("--form", choices=("auto", "expanded"), default="auto",
+                   help="how the C code evaluates the terms: auto (M, g, tau by the recursions, C expanded) "
+                        "or expanded (every term expanded)")
+    p.set_defaults(func=cmd_derive)

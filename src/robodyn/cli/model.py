@@ -1,41 +1,14 @@
-"""The ``robodyn`` command line.
-
-    robodyn info MODEL          joint table, masses and inertias of a built-in robot or URDF
-    robodyn demo [MODEL]        inverse and forward dynamics and the mass matrix at a sample state
-    robodyn bench [MODEL]       per-call timings (and the comparison with Pinocchio if installed)
-    robodyn simulate MODEL      simulation, free or controlled (plots, GIF, CSV; see cli_simulation)
-    robodyn torques MODEL CSV   joint forces of a trajectory: inertial, Coriolis, gravity
-    robodyn excite MODEL ...    excitation trajectory for identification (robodyn.identification.cli)
-    robodyn identify MODEL CSV  identified parameters, URDF and report (robodyn.identification.cli)
-    robodyn derive MODEL        closed-form M, C, g (sympy), as LaTeX and C code
-
-MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
-"""
+"""``robodyn info``, ``robodyn demo``, ``robodyn bench`` and ``robodyn warmup``: a model's tables,
+its dynamics at a sample state, timings, and compiling every kernel ahead of time."""
 
 from __future__ import annotations
 
-import argparse
-import os
 import sys
-import warnings
 
 import numpy as np
 
-from . import models
-from .errors import ModelError
-
-
-def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
-    """A built-in robot by name, or a URDF file by path."""
-    from .io.urdf import load_urdf
-
-    if spec in models.names():
-        if floating_base:
-            raise ValueError("--floating-base applies to URDF files; built-in robots have a fixed base")
-        return models.load(spec)
-    if spec.endswith(".urdf") or "/" in spec:
-        return load_urdf(spec, floating_base=floating_base, physical=physical)
-    raise ValueError(f"unknown model {spec!r}: give a URDF path or one of {models.names()}")
+from .. import models
+from .common import add_model_arguments, load_model
 
 
 def _fmt(x, width=9, prec=4) -> str:
@@ -69,8 +42,8 @@ def cmd_info(args) -> int:
 
 def sample_state(model, seed: int = 0):
     """A reproducible sample state: mid-range joint angles, moderate speeds and accelerations."""
-    from .joints import FREE
-    from .random import random_configuration
+    from ..joints import FREE
+    from ..random import random_configuration
 
     rng = np.random.default_rng(seed)
     q = random_configuration(model, rng)
@@ -120,7 +93,7 @@ def cmd_demo(args) -> int:
 
 
 def _dof_names(model) -> list[str]:
-    from .joints import NV
+    from ..joints import NV
 
     names = []
     for i in range(model.nbodies):
@@ -133,71 +106,49 @@ def _dof_names(model) -> list[str]:
 
 
 def cmd_bench(args) -> int:
-    from .bench import run_bench
+    from ..bench import run_bench
 
     model = load_model(args.model, args.floating_base, args.physical)
     return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
 
 
-def cmd_derive(args) -> int:
-    from .symbolic.cli import run_derive  # imports sympy
+def cmd_warmup(args) -> int:
+    """Compile (first run) or load every kernel, with a progress bar on a terminal."""
+    import time
 
-    return run_derive(load_model(args.model, args.floating_base, args.physical), args)
+    from .._warmup import warmup
+    from ..simulation.simulate import Progress
+
+    bar, start, count = None, time.perf_counter(), [0]
+
+    def progress(done, total, name):
+        nonlocal bar
+        if bar is None:
+            bar = Progress(total)
+        bar.update(done)
+        count[0] = total
+
+    warmup(progress)
+    bar.close()
+    print(f"robodyn warmup: {count[0]} steps compiled or loaded from the cache in "
+          f"{time.perf_counter() - start:.1f} s")
+    return 0
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics.")
-    sub = parser.add_subparsers(dest="command", required=True)
-
-    def common(p, default=None):
-        p.add_argument("model", nargs="?", default=default, help="built-in robot name or URDF path")
-        p.add_argument("--floating-base", action="store_true", help="URDF: add a free-flying base")
-        p.add_argument("--physical", choices=("error", "warn"), default="error",
-                       help="URDF: reject (error) or keep with a warning (warn) unphysical inertias")
-
+def add_commands(sub) -> None:
+    """Register ``info``, ``demo``, ``bench`` and ``warmup`` on the ``robodyn`` subcommand parser."""
     p = sub.add_parser("info", help="print the joint table, masses and inertias")
-    common(p)
+    add_model_arguments(p)
     p.add_argument("--list", action="store_true", help="list the built-in robots")
     p.set_defaults(func=cmd_info)
     p = sub.add_parser("demo", help="inverse/forward dynamics and mass matrix at a sample state")
-    common(p, default="panda")
+    add_model_arguments(p, default="panda")
     p.add_argument("--seed", type=int, default=0)
     p.set_defaults(func=cmd_demo)
     p = sub.add_parser("bench", help="per-call timings (and the comparison with Pinocchio)")
-    common(p, default="panda")
+    add_model_arguments(p, default="panda")
     p.add_argument("--batch", type=int, default=10000, help="batch size for the batched timings")
     p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
     p.set_defaults(func=cmd_bench)
-    from .cli_simulation import add_commands as add_simulation_commands
-    from .identification.cli import add_commands as add_identification_commands
-
-    add_simulation_commands(sub, common)
-    add_identification_commands(sub, common)
-
-    p = sub.add_parser("derive", help="closed-form equations of motion: LaTeX and C code")
-    common(p)
-    p.add_argument("--method", choices=("lagrange", "newton_euler"), default="lagrange")
-    p.add_argument("--latex", metavar="FILE", help="write a LaTeX document of every term")
-    p.add_argument("--c", metavar="DIR", dest="c_dir", help="write C source and header into DIR")
-    p.add_argument("--form", choices=("auto", "expanded"), default="auto",
-                   help="how the C code evaluates the terms: auto (M, g, tau by the recursions, C expanded) "
-                        "or expanded (every term expanded)")
-    p.set_defaults(func=cmd_derive)
-
-    args = parser.parse_args(argv)
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("default")
-            status = args.func(args)
-        sys.stdout.flush()  # a closed pipe shows here, inside the try
-        return status
-    except (ModelError, ValueError) as e:
-        print(f"robodyn: error: {e}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:  # the reader stopped early (``robodyn demo | head``): exit quietly
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+    p = sub.add_parser("warmup", help="compile (or load from the cache) every kernel now, with a progress bar")
+    p.set_defaults(func=cmd_warmup)

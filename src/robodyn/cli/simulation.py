@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .common import add_model_arguments, load_model
+
 CONTROLLERS = ("none", "pd-gravity", "computed-torque")
 
 
@@ -38,7 +40,7 @@ def _vector(text: str | None, n: int, name: str):
 def start_and_target(model, q0=None, target=None):
     """Default start (0, or mid-range outside the limits) and target (``q0 + 0.5`` inside the
     limits) of the 1-dof joints; a floating base starts at the origin, upright."""
-    from .joints import FREE
+    from ..joints import FREE
 
     if q0 is None:
         q0 = np.zeros(model.nq)
@@ -56,18 +58,16 @@ def start_and_target(model, q0=None, target=None):
 
 
 def cmd_simulate(args) -> int:
-    from . import control
-    from .plots import animate, plot_simulation
-    from .simulation import simulate
-
-    from .cli import load_model
+    from .. import control
+    from ..plots import animate, plot_simulation
+    from ..simulation import simulate
 
     model = load_model(args.model, args.floating_base, args.physical)
     if args.reference and args.controller != "computed-torque":
         raise ValueError("--reference applies to --controller computed-torque")
     q_start = _vector(args.q0, model.nq, "--q0")
     if args.reference and q_start is None:
-        from .simulation.trajectory import read_csv
+        from ..simulation.trajectory import read_csv
 
         q_start = read_csv(model, args.reference)[1][0]
     q0, target = start_and_target(model, q_start, _vector(args.target, model.nv, "--target"))
@@ -77,7 +77,7 @@ def cmd_simulate(args) -> int:
     if args.controller == "none":
         controller = None
     elif args.controller == "pd-gravity":
-        from .algorithms.crba import crba
+        from ..algorithms.crba import crba
 
         m = np.diag(crba(model, q0)) if model.nq == model.nv else np.ones(model.nv)
         controller = control.PDGravity(model, target, w * w * m, 2.0 * w * m)
@@ -113,10 +113,8 @@ def cmd_simulate(args) -> int:
 
 
 def cmd_torques(args) -> int:
-    from .plots import plot_torques
-    from .simulation.trajectory import coordinate_names, read_csv
-
-    from .cli import load_model
+    from ..plots import plot_torques
+    from ..simulation.trajectory import coordinate_names, read_csv
 
     model = load_model(args.model, args.floating_base, args.physical)
     t, q, v, a = read_csv(model, args.trajectory)
@@ -131,12 +129,12 @@ def cmd_torques(args) -> int:
     return 0
 
 
-def add_commands(sub, common) -> None:
+def add_commands(sub) -> None:
     """Register ``simulate`` and ``torques`` on the ``robodyn`` subcommand parser."""
-    from .simulation import INTEGRATORS, SCIPY_INTEGRATORS
+    from ..simulation import INTEGRATORS, SCIPY_INTEGRATORS
 
     p = sub.add_parser("simulate", help="simulate the robot, free or under a controller; plots, GIF, CSV")
-    common(p)
+    add_model_arguments(p)
     p.add_argument("--controller", choices=CONTROLLERS, default="none")
     p.add_argument("--duration", type=float, default=5.0, help="seconds (default 5)")
     p.add_argument("--dt", type=float, default=1e-3, help="sample time and fixed step, seconds (default 0.001)")
@@ -154,7 +152,7 @@ def add_commands(sub, common) -> None:
     p.add_argument("--csv", help="write the trajectory (t, q, v, a, tau, energy, ...) as CSV")
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("torques", help="joint forces of a trajectory split into inertial, Coriolis, gravity")
-    common(p)
+    add_model_arguments(p)
     p.add_argument("trajectory", help="CSV file with a 't' column and 'q:<joint>' columns (e.g. simulate --csv)")
     p.add_argument("--plot", help="PNG of the contributions per joint")
     p.set_defaults(func=cmd_torques)

@@ -1,0 +1,7 @@
+"""``python -m robodyn.cli``."""
+
+import sys
+
+from .main import main
+
+sys.exit(main())
