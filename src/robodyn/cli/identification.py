@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import add_model_arguments, load_model
+from .common import add_model_arguments, check_output_dir, check_output_file, load_model
 
 
 def _model(args):
@@ -23,6 +23,7 @@ def cmd_excite(args) -> int:
     from ..identification.base import base_parameters
     from ..identification.excitation import limits_of, optimize_excitation, write_excitation
 
+    check_output_file(args.out, "--out")
     model = _model(args)
     base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction)
     period = args.period if args.period is not None else args.duration
@@ -45,6 +46,8 @@ def cmd_identify(args) -> int:
     from ..identification.identify import identify
     from ..identification.report import write_report
 
+    check_output_file(args.out, "--out")
+    check_output_dir(args.report, "--report")
     model = _model(args)
     log = preprocess(read_log(args.data, model), cutoff=args.cutoff, decimate=args.decimate)
     base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction, offset=args.offset)

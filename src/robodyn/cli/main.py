@@ -11,6 +11,11 @@
     robodyn derive MODEL        closed-form M, C, g (sympy), as LaTeX and C code
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
+
+Exit status: 0 success; 2 bad input or output (the message names the file or option: missing,
+unreadable, malformed or unphysical input, an output whose directory is missing or not
+writable, checked before the work starts); 130 interrupted (Ctrl-C); 1 an unexpected error
+(one line; ``robodyn --debug ...`` shows the traceback). A closed pipe exits quietly with 0.
 """
 
 from __future__ import annotations
@@ -28,6 +33,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="robodyn", description="Rigid-body robot dynamics.")
     sub = parser.add_subparsers(dest="command", required=True)
 
+    parser.add_argument("--debug", action="store_true", help="show the Python traceback of an unexpected error")
     for commands in (model, simulation, identification, symbolic):
         commands.add_commands(sub)
 
@@ -44,3 +50,16 @@ def main(argv=None) -> int:
     except BrokenPipeError:  # the reader stopped early (``robodyn demo | head``): exit quietly
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as e:  # a missing or unreadable input, a directory given for a file, ...
+        where = f"{e.filename}: " if e.filename is not None else ""
+        print(f"robodyn: error: {where}{e.strerror or e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("robodyn: interrupted", file=sys.stderr)
+        return 130
+    except Exception as e:  # noqa: BLE001 - a defect: one line, the traceback on request
+        if args.debug:
+            raise
+        print(f"robodyn: internal error: {type(e).__name__}: {e} (rerun with --debug for the traceback)",
+              file=sys.stderr)
+        return 1

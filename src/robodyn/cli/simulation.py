@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import add_model_arguments, load_model
+from .common import add_model_arguments, check_output_file, load_model
 
 CONTROLLERS = ("none", "pd-gravity", "computed-torque")
 
@@ -62,6 +62,8 @@ def cmd_simulate(args) -> int:
     from ..plots import animate, plot_simulation
     from ..simulation import simulate
 
+    for option in ("csv", "plot", "gif"):
+        check_output_file(getattr(args, option), f"--{option}")
     model = load_model(args.model, args.floating_base, args.physical)
     if args.reference and args.controller != "computed-torque":
         raise ValueError("--reference applies to --controller computed-torque")
@@ -116,6 +118,7 @@ def cmd_torques(args) -> int:
     from ..plots import plot_torques
     from ..simulation.trajectory import coordinate_names, read_csv
 
+    check_output_file(args.plot, "--plot")
     model = load_model(args.model, args.floating_base, args.physical)
     t, q, v, a = read_csv(model, args.trajectory)
     data = plot_torques(model, t, q, v, a, args.plot)

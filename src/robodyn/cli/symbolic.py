@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import add_model_arguments, load_model
+from .common import add_model_arguments, check_output_dir, check_output_file, load_model
 
 
 def run_derive(model, args) -> int:
@@ -40,6 +40,8 @@ def run_derive(model, args) -> int:
 
 
 def cmd_derive(args) -> int:
+    check_output_file(args.latex, "--latex")
+    check_output_dir(args.c_dir, "--c")
     return run_derive(load_model(args.model, args.floating_base, args.physical), args)
 
 

@@ -82,13 +82,16 @@ def read_log(path, model, *, require_tau: bool = True) -> Log:
     """
     _fixed_base(model, "read_log")
     path = Path(path)
-    with open(path, newline="") as f:
-        reader = csv.reader(f)
-        try:
-            header = [h.strip() for h in next(reader)]
-        except StopIteration:
-            raise ValueError(f"{path}: empty file, expected a header row") from None
-        rows = [(reader.line_num, row) for row in reader if any(cell.strip() for cell in row)]
+    try:
+        with open(path, newline="") as f:
+            reader = csv.reader(f)
+            try:
+                header = [h.strip() for h in next(reader)]
+            except StopIteration:
+                raise ValueError(f"{path}: empty file, expected a header row") from None
+            rows = [(reader.line_num, row) for row in reader if any(cell.strip() for cell in row)]
+    except (UnicodeDecodeError, csv.Error) as e:
+        raise ValueError(f"{path}: not a CSV text file ({e})") from None
     index = {name: k for k, name in enumerate(header)}
     need = ["time"] + column_names(model, "q") + (column_names(model, "tau") if require_tau else [])
     missing = [n for n in need if n not in index]

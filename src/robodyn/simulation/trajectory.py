@@ -96,8 +96,11 @@ def read_csv(model, path):
     """
     from scipy.interpolate import CubicSpline
 
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f))
+    except (UnicodeDecodeError, csv.Error) as e:
+        raise ValueError(f"{path}: not a CSV text file ({e})") from None
     if len(rows) < 3:
         raise ValueError(f"{path}: need a header line and at least 2 samples, got {max(len(rows) - 1, 0)} samples")
     header = [h.strip() for h in rows[0]]

@@ -1,0 +1,124 @@
+"""Every subcommand against bad inputs and unusable output paths: exit status 2, one line on
+stderr naming the culprit, no traceback, no output file left behind."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+import pytest
+
+from robodyn.cli import main
+
+JOINTS = [f"panda_joint{k}" for k in range(1, 8)] + ["panda_finger_joint1", "panda_finger_joint2"]
+
+
+def _inputs(tmp_path):
+    """Bad input files by kind."""
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    binary = tmp_path / "binary.csv"
+    binary.write_bytes(bytes(range(256)) * 4)
+    columns = tmp_path / "columns.csv"
+    columns.write_text("a,b\n1,2\n3,4\n5,6\n")
+    header = "t," + ",".join(f"q:{j}" for j in JOINTS)
+    nan = tmp_path / "nan.csv"
+    nan.write_text(header + "\n" + "\n".join(f"{k * 0.1}," + ",".join(["nan"] * 9) for k in range(4)) + "\n")
+    log_header = "time," + ",".join(f"q_{j}" for j in JOINTS) + "," + ",".join(f"tau_{j}" for j in JOINTS)
+    log_nan = tmp_path / "log_nan.csv"
+    log_nan.write_text(log_header + "\n" + "\n".join(f"{k * 0.1}," + ",".join(["nan"] * 18) for k in range(4)) + "\n")
+    huge = tmp_path / "huge.csv"
+    huge.write_text(header + "\n" + "\n".join(f"{k * 0.1}," + ",".join(["1e308"] * 9) for k in range(4)) + "\n")
+    return {"missing": tmp_path / "missing.csv", "directory": tmp_path, "empty": empty, "binary": binary,
+            "columns": columns, "nan": nan, "log_nan": log_nan, "huge": huge}
+
+
+INPUT_CASES = [
+    ("torques", ["torques", "panda", "{file}"], ["missing", "directory", "empty", "binary", "columns", "nan", "huge"]),
+    ("identify", ["identify", "panda", "{file}"], ["missing", "directory", "empty", "binary", "columns", "log_nan"]),
+    ("simulate --reference", ["simulate", "panda", "--controller", "computed-torque", "--duration", "0.01",
+                              "--reference", "{file}"], ["missing", "directory", "empty", "binary", "columns", "nan"]),
+]
+
+
+@pytest.mark.parametrize("name, argv, kinds", INPUT_CASES, ids=[c[0] for c in INPUT_CASES])
+def test_bad_inputs_give_one_line_and_status_2(capsys, tmp_path, name, argv, kinds):
+    files = _inputs(tmp_path)
+    for kind in kinds:
+        path = files[kind]
+        code = main([a.replace("{file}", str(path)) for a in argv])
+        out, err = capsys.readouterr()
+        lines = err.strip().splitlines()
+        assert code == 2, (kind, err)
+        assert len(lines) == 1 and lines[0].startswith("robodyn: error: "), (kind, err)
+        assert "Traceback" not in err
+        assert path.name in lines[0] or str(path) in lines[0], (kind, err)
+
+
+OUTPUT_CASES = [
+    (["simulate", "panda", "--duration", "0.01", "--csv", "{out}"], "--csv"),
+    (["simulate", "panda", "--duration", "0.01", "--plot", "{out}"], "--plot"),
+    (["simulate", "panda", "--duration", "0.01", "--gif", "{out}"], "--gif"),
+    (["torques", "panda", "{traj}", "--plot", "{out}"], "--plot"),
+    (["excite", "panda", "--out", "{out}"], "--out"),
+    (["identify", "panda", "{traj}", "--out", "{out}"], "--out"),
+    (["identify", "panda", "{traj}", "--report", "{out}"], "--report"),
+    (["derive", "pendulum", "--latex", "{out}"], "--latex"),
+    (["derive", "pendulum", "--c", "{out}"], "--c"),
+]
+
+
+@pytest.mark.parametrize("argv, option", OUTPUT_CASES, ids=[" ".join(c[0][:1] + [c[1]]) for c in OUTPUT_CASES])
+def test_unusable_outputs_refused_before_the_work(capsys, tmp_path, argv, option):
+    """A missing directory, a read-only one, or (for files) an existing directory: refused at
+    once, naming the option, and nothing is written."""
+    traj = tmp_path / "traj.csv"  # never read: the output is checked first
+    readonly = tmp_path / "readonly"
+    readonly.mkdir()
+    readonly.chmod(0o555)
+    is_file_option = option != "--report" and option != "--c"
+    targets = [tmp_path / "no" / "such" / "x.out", readonly / "x.out"]
+    if is_file_option:
+        targets.append(tmp_path)
+    if os.geteuid() == 0:  # root writes into read-only directories: that case cannot fail here
+        targets.remove(readonly / "x.out")
+    for out in targets:
+        before = sorted(tmp_path.rglob("*"))
+        code = main([a.replace("{out}", str(out)).replace("{traj}", str(traj)) for a in argv])
+        _, err = capsys.readouterr()
+        lines = err.strip().splitlines()
+        assert code == 2, (out, err)
+        assert len(lines) == 1 and lines[0].startswith(f"robodyn: error: {option} "), (out, err)
+        assert sorted(tmp_path.rglob("*")) == before  # nothing written
+
+
+def test_unexpected_error_is_one_line_and_debug_shows_the_traceback(capsys, monkeypatch):
+    from robodyn.cli import model as commands
+
+    def broken(model, seed=0):
+        raise RuntimeError("a defect")
+
+    monkeypatch.setattr(commands, "sample_state", broken)
+    assert main(["demo", "pendulum"]) == 1
+    err = capsys.readouterr().err
+    assert err.strip() == "robodyn: internal error: RuntimeError: a defect (rerun with --debug for the traceback)"
+    with pytest.raises(RuntimeError, match="a defect"):
+        main(["--debug", "demo", "pendulum"])
+
+
+def test_interrupt_exits_130(capsys, monkeypatch):
+    from robodyn.cli import model as commands
+
+    def interrupted(model, seed=0):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(commands, "sample_state", interrupted)
+    assert main(["demo", "pendulum"]) == 130
+    assert capsys.readouterr().err.strip() == "robodyn: interrupted"
+
+
+def test_results_of_a_good_run_are_written(tmp_path, capsys):
+    """The checks let a usable output through."""
+    out = tmp_path / "traj.csv"
+    assert main(["simulate", "pendulum", "--duration", "0.01", "--csv", str(out)]) == 0
+    assert out.exists() and np.isfinite(np.loadtxt(out, delimiter=",", skiprows=1)).all()
