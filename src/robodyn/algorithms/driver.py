@@ -10,7 +10,7 @@ An algorithm supplies three compiled pieces and gets its batch kernel from :func
     allocates one worker's scratch (called once per worker thread, never per state).
 ``views(args, ws) -> ws`` (optional)
     rebuilds the workspace views once per chunk, where the compiler sees their constant
-    shapes (see ``_workspace``); the default keeps ``ws`` as it is.
+    shapes (see ``_workspace``); without it the state function gets ``ws`` as allocated.
 
 The kernel, ``batch(args, sizes, status, nchunk)``, runs all states ``s < status.shape[0]``
 on all threads, ``nchunk = chunks(B)`` from Python. The batch is cut into ``nchunk`` chunks of
@@ -106,20 +106,19 @@ def _cached(dispatcher):
     return dispatcher
 
 
-@inline
-def same_workspace(args, ws):
-    """The default ``views``: the workspace as allocated."""
-    return ws
-
-
-def batch_kernel(state_at, workspace, views=same_workspace):
+def batch_kernel(state_at, workspace, views=None):
     """The parallel batch kernel ``batch(args, sizes, status, nchunk)`` of an algorithm whose
     one state is ``state_at(args, s, ws)`` (see the module docstring)."""
 
-    def run_range(args, status, lo, hi, ws):
-        ws = views(args, ws)
-        for s in range(lo, hi):
-            status[s] = state_at(args, s, ws)
+    if views is None:
+        def run_range(args, status, lo, hi, ws):
+            for s in range(lo, hi):
+                status[s] = state_at(args, s, ws)
+    else:
+        def run_range(args, status, lo, hi, ws):
+            ws = views(args, ws)
+            for s in range(lo, hi):
+                status[s] = state_at(args, s, ws)
 
     run_range = _cached(core(run_range))
 
