@@ -51,7 +51,7 @@ def _save(fig, path) -> None:
 
 
 def _dof_labels(model) -> list[str]:
-    from .simulation.trajectory import coordinate_names
+    from .io.trajectory_csv import coordinate_names
 
     return coordinate_names(model)[1]
 

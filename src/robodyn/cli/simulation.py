@@ -11,7 +11,7 @@ tracks a quintic from ``q0`` to the target in the first half of the run, or the 
 of a CSV file given with ``--reference`` (interpolated by a cubic spline). The gains follow
 from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
 so that light wrist joints do not make the closed loop too stiff for the fixed step). ``--csv`` writes
-the trajectory in the format of :mod:`robodyn.simulation.trajectory`, which ``torques``
+the trajectory in the format of :mod:`robodyn.io.trajectory_csv`, which ``torques``
 reads (or any CSV with a ``t`` column and ``q:<joint>`` columns) to plot the joint forces
 split into inertial, Coriolis/centrifugal and gravity parts.
 """
@@ -69,7 +69,7 @@ def cmd_simulate(args) -> int:
         raise ValueError("--reference applies to --controller computed-torque")
     q_start = _vector(args.q0, model.nq, "--q0")
     if args.reference and q_start is None:
-        from ..simulation.trajectory import read_csv
+        from ..io.trajectory_csv import read_csv
 
         q_start = read_csv(model, args.reference)[1][0]
     q0, target = start_and_target(model, q_start, _vector(args.target, model.nv, "--target"))
@@ -116,7 +116,7 @@ def cmd_simulate(args) -> int:
 
 def cmd_torques(args) -> int:
     from ..plots import plot_torques
-    from ..simulation.trajectory import coordinate_names, read_csv
+    from ..io.trajectory_csv import coordinate_names, read_csv
 
     check_output_file(args.plot, "--plot")
     model = load_model(args.model, args.floating_base, args.physical)

@@ -128,8 +128,8 @@ class Sampled:
 
     @classmethod
     def from_csv(cls, model, path) -> "Sampled":
-        """The ``q`` columns of a trajectory CSV file (format of ``robodyn.simulation.trajectory``)."""
-        from ..simulation.trajectory import read_csv
+        """The ``q`` columns of a trajectory CSV file (format of ``robodyn.io.trajectory_csv``)."""
+        from ..io.trajectory_csv import read_csv
 
         t, q, _, _ = read_csv(model, path)
         return cls(t, q)

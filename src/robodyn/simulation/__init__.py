@@ -5,6 +5,7 @@
 """
 
 from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, simulate
-from .trajectory import Trajectory, coordinate_names, read_csv
+from ..io.trajectory_csv import coordinate_names, read_csv
+from .trajectory import Trajectory
 
 __all__ = ["simulate", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]
