@@ -140,3 +140,27 @@ def test_cycle_finder_finds_a_cycle():
 def test_no_import_cycle():
     cycle = find_cycle(import_graph(FILES))
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
+
+
+# Packages that a module of the key may not import (ARCHITECTURE.md, "Layers").
+FORBIDDEN = {
+    "robodyn.algorithms": ("robodyn.simulation", "robodyn.control", "robodyn.identification", "robodyn.symbolic",
+                           "robodyn.cli", "robodyn.interop"),
+    "robodyn.control": ("robodyn.simulation", "robodyn.identification", "robodyn.cli"),
+    "robodyn.simulation": ("robodyn.identification", "robodyn.cli"),
+    "robodyn.io": ("robodyn.algorithms", "robodyn.simulation", "robodyn.control", "robodyn.cli"),
+    "robodyn.interop": ("robodyn.algorithms", "robodyn.simulation", "robodyn.control", "robodyn.cli"),
+    "robodyn": ("robodyn.cli",),  # nothing outside the command line imports it
+}
+
+
+def test_layers_import_downward_only():
+    graph = import_graph(FILES)
+    found = []
+    for module, targets in graph.items():
+        owner = max((k for k in FORBIDDEN if module == k or module.startswith(k + ".")), key=len, default=None)
+        if owner is None or module.startswith("robodyn.cli"):
+            continue
+        found += [f"{module} imports {t}" for t in sorted(targets)
+                  if any(t == f or t.startswith(f + ".") for f in FORBIDDEN[owner])]
+    assert found == []
