@@ -47,7 +47,10 @@ def _figure(rows: int, cols: int = 1, size=(8.0, 3.0)):
 
 def _save(fig, path) -> None:
     if path is not None:
-        fig.savefig(path, dpi=100)
+        from .files import atomic_path
+
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=100)
 
 
 def _dof_labels(model) -> list[str]:
@@ -262,5 +265,8 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
         w, h = canvas.get_width_height()
         frames.append(Image.frombuffer("RGBA", (w, h), bytes(canvas.buffer_rgba()), "raw", "RGBA", 0, 1).convert(
             "RGB").quantize(colors=64))
-    frames[0].save(path, save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0)
+    from .files import atomic_path
+
+    with atomic_path(path) as tmp:
+        frames[0].save(tmp, save_all=True, append_images=frames[1:], duration=round(1000 / fps), loop=0)
     return data

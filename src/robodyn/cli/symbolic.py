@@ -6,6 +6,7 @@ import sys
 import time
 
 from .common import add_model_arguments, check_output_dir, check_output_file, load_model
+from ..files import write_text
 
 
 def run_derive(model, args) -> int:
@@ -28,8 +29,7 @@ def run_derive(model, args) -> int:
         for name in ("M", "C", "g"):
             print(f"  {name} = {eom.term(name).tolist()}")
     if args.latex:
-        with open(args.latex, "w") as f:
-            f.write(eom.latex())
+        write_text(args.latex, eom.latex())
         print(f"  LaTeX: {args.latex}")
     if args.c_dir:
         files = eom.to_c(args.c_dir, form=args.form)

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path
 from ..joints import FREE
 
 KINDS = ("q", "qd", "qdd", "tau")
@@ -66,7 +67,7 @@ def write_log(path, model, t, q, *, qd=None, qdd=None, tau=None) -> Path:
             header += column_names(model, kind)
             cols.append(x)
     data = np.hstack(cols)
-    with open(path, "w", newline="") as f:
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(header)
         w.writerows([[repr(float(v)) for v in row] for row in data])

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path
 from ..joints import FREE
 from ._blas import one_blas_thread
 
@@ -81,7 +82,8 @@ class FourierTrajectory:
         axes[-1].set_xlabel("t [s]")
         axes[0].set_title(f"Excitation trajectory ({self.harmonics} harmonics, period {self.period:g} s)")
         fig.tight_layout()
-        fig.savefig(path, dpi=100)
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=100)
         plt.close(fig)
         return Path(path)
 

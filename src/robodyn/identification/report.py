@@ -17,7 +17,13 @@ from pathlib import Path
 
 import numpy as np
 
+from ..files import atomic_path, write_text
 from .data import Log
+
+
+def _save(fig, path) -> None:
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90)
 
 
 def rms_per_joint(pred: np.ndarray, tau: np.ndarray) -> np.ndarray:
@@ -47,7 +53,7 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
         text += [f"  {name:<20} {r:.6g}" for name, r in zip(model.joint_names, vrms)]
     text += ["", result.base.summary()]
     paths = [out / "report.txt"]
-    paths[0].write_text("\n".join(text) + "\n")
+    write_text(paths[0], "\n".join(text) + "\n")
 
     nv = model.nv
     fig, axes = plt.subplots(nv, 1, figsize=(9, 1.8 * nv + 1), sharex=True, squeeze=False)
@@ -61,7 +67,7 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
     paths.append(out / "torques.png")
-    fig.savefig(paths[-1], dpi=90)
+    _save(fig, paths[-1])
     plt.close(fig)
 
     res = log.tau - pred
@@ -77,7 +83,7 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     axes[-1, 0].set_xlabel("t [s]")
     fig.tight_layout()
     paths.append(out / "residuals.png")
-    fig.savefig(paths[-1], dpi=90)
+    _save(fig, paths[-1])
     plt.close(fig)
 
     W = result.base.regressor(model, log.q, log.qd, log.qdd).reshape(-1, result.base.count)
@@ -90,6 +96,6 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     ax.grid(True, alpha=0.3)
     fig.tight_layout()
     paths.append(out / "singular_values.png")
-    fig.savefig(paths[-1], dpi=90)
+    _save(fig, paths[-1])
     plt.close(fig)
     return paths

@@ -18,11 +18,11 @@ limit raises ``ValueError``.
 from __future__ import annotations
 
 import warnings
-from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..files import write_text
 from .. import joints as J
 from ..errors import RobodynWarning
 
@@ -136,5 +136,5 @@ def write_urdf(model, path=None) -> str:
     if lost:
         warnings.warn(f"write_urdf: URDF cannot hold {', '.join(lost)}; not written", RobodynWarning, stacklevel=2)
     if path is not None:
-        Path(path).write_text(text)
+        write_text(path, text)
     return text

@@ -9,6 +9,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..files import atomic_path
 from ..io.trajectory_csv import coordinate_names
 
 
@@ -53,7 +54,7 @@ class Trajectory:
         cols = [self.t[:, None], self.q, self.v, self.a, self.tau, self.energy[:, None]]
         if self.lyapunov is not None:
             cols.append(self.lyapunov[:, None])
-        with open(path, "w", newline="") as f:
+        with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
             w = csv.writer(f)
             w.writerow(header)
             w.writerows(np.hstack(cols).tolist())

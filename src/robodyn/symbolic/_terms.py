@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..files import write_text
 from . import codegen
 
 # term -> (inputs, description)
@@ -100,5 +101,5 @@ class GeneratedCode:
             d = Path(directory)
             d.mkdir(parents=True, exist_ok=True)
             for k, v in files.items():
-                (d / k).write_text(v)
+                write_text(d / k, v)
         return files
