@@ -122,3 +122,28 @@ def test_results_of_a_good_run_are_written(tmp_path, capsys):
     out = tmp_path / "traj.csv"
     assert main(["simulate", "pendulum", "--duration", "0.01", "--csv", str(out)]) == 0
     assert out.exists() and np.isfinite(np.loadtxt(out, delimiter=",", skiprows=1)).all()
+
+
+MODEL_COMMANDS = [["info"], ["demo"], ["bench", "--no-compare"], ["simulate", "--duration", "0.01"],
+                  ["excite", "--out", "x.csv"], ["derive"]]
+
+
+@pytest.mark.parametrize("command", MODEL_COMMANDS, ids=[c[0] for c in MODEL_COMMANDS])
+def test_bad_model_arguments(capsys, tmp_path, monkeypatch, command):
+    """Every command that takes a MODEL: a missing, directory, binary or empty URDF, or an
+    unknown name, is one line naming it, status 2."""
+    monkeypatch.chdir(tmp_path)
+    binary = tmp_path / "bin.urdf"
+    binary.write_bytes(b"\xff\xfe\x00binary")
+    empty = tmp_path / "empty.urdf"
+    empty.write_text("")
+    (tmp_path / "dir.urdf").mkdir()
+    for spec in (str(tmp_path / "missing.urdf"), str(tmp_path / "dir.urdf"), str(binary), str(empty), "nosuchrobot"):
+        argv = [command[0], spec, *command[1:]]
+        code = main(argv)
+        _, err = capsys.readouterr()
+        lines = err.strip().splitlines()
+        assert code == 2, (argv, err)
+        assert len(lines) == 1 and lines[0].startswith("robodyn: error: ") and "Traceback" not in err, (argv, err)
+        assert spec.rsplit("/", 1)[-1] in lines[0], (argv, err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bin.urdf", "dir.urdf", "empty.urdf"]  # nothing written
