@@ -147,3 +147,29 @@ def test_bad_model_arguments(capsys, tmp_path, monkeypatch, command):
         assert len(lines) == 1 and lines[0].startswith("robodyn: error: ") and "Traceback" not in err, (argv, err)
         assert spec.rsplit("/", 1)[-1] in lines[0], (argv, err)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bin.urdf", "dir.urdf", "empty.urdf"]  # nothing written
+
+
+def test_a_write_that_fails_after_the_work_saves_the_result_elsewhere(capsys, tmp_path, monkeypatch):
+    """The disk fills up (or the directory goes away) after the simulation ran: the CSV goes
+    to a new temporary directory, stdout and the one error line say where, status 2."""
+    import robodyn.files as files
+
+    target = tmp_path / "traj.csv"
+    real_replace = os.replace
+
+    def full_disk(src, dst):
+        if str(dst) == str(target):
+            raise OSError(28, "No space left on device")
+        real_replace(src, dst)
+
+    monkeypatch.setattr(files.os, "replace", full_disk)
+    code = main(["simulate", "pendulum", "--duration", "0.01", "--csv", str(target)])
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert code == 2 and len(lines) == 1, err
+    assert f"--csv {target}: No space left on device; saved to " in lines[0]
+    rescued = lines[0].rsplit("saved to ", 1)[1].removesuffix(" instead")
+    assert f"wrote {rescued}" in out
+    assert not target.exists() and sorted(p.name for p in tmp_path.iterdir()) == []
+    t = np.loadtxt(rescued, delimiter=",", skiprows=1)[:, 0]
+    np.testing.assert_allclose(t, np.arange(11) * 0.001)  # the whole run

@@ -6,6 +6,7 @@ Imported by every command module; imports none of them.
 from __future__ import annotations
 
 import os
+import tempfile
 from pathlib import Path
 
 from .. import models
@@ -61,3 +62,39 @@ def check_output_dir(path, option: str) -> None:
             raise ValueError(f"{option} {path}: the directory is not writable")
         return
     check_output_file(path, option)
+
+
+# Outputs that could not be written where asked and were saved elsewhere (see :func:`save`);
+# ``main`` reports them and exits 2 once the command has finished.
+RESCUED: list[str] = []
+
+
+def save(write, path, option: str):
+    """``write(path)``, so that finished work is never lost: when it fails with an ``OSError``
+    (a full disk, the directory removed meanwhile), the result goes into a new directory of the
+    system's temporary directory instead, and the failure and the new place are recorded for
+    ``main`` to report. Returns what ``write`` returns (nothing is written for ``path=None``)."""
+    if path is None:
+        return write(None)
+    try:
+        return write(path)
+    except OSError as e:
+        rescue = Path(tempfile.mkdtemp(prefix="robodyn-")) / Path(path).name
+        result = write(rescue)
+        RESCUED.append(f"{option} {path}: {e.strerror or e}; saved to {rescue} instead")
+        _WHERE[str(path)] = rescue
+        return result
+
+
+_WHERE: dict[str, Path] = {}
+
+
+def written(path):
+    """Where :func:`save` put ``path``'s result: ``path``, or the place it was saved instead."""
+    return _WHERE.get(str(path), path)
+
+
+def reset() -> None:
+    """Forget the rescued outputs of a previous command (``main`` runs one per call)."""
+    RESCUED.clear()
+    _WHERE.clear()

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import add_model_arguments, check_output_dir, check_output_file, load_model
+from .common import add_model_arguments, check_output_dir, check_output_file, load_model, save, written
 
 
 def _model(args):
@@ -34,7 +34,7 @@ def cmd_excite(args) -> int:
                                  limits=lim, maxiter=args.maxiter, seed=args.seed)
     print(f"condition number of the base regressor: {result.initial_condition_number:.4g} (initial) -> "
           f"{result.condition_number:.4g} after {result.iterations} iterations ({result.message})")
-    for path in write_excitation(args.out, model, result, args.duration, args.rate):
+    for path in save(lambda out: write_excitation(out, model, result, args.duration, args.rate), args.out, "--out"):
         print(f"wrote {path}")
     return 0
 
@@ -54,10 +54,10 @@ def cmd_identify(args) -> int:
     result = identify(model, log, method=args.method, base=base)
     print(result.summary())
     if args.out:
-        write_urdf(result.identified_model(), args.out)
-        print(f"wrote {args.out}")
+        save(lambda out: write_urdf(result.identified_model(), out), args.out, "--out")
+        print(f"wrote {written(args.out)}")
     if args.report:
-        for path in write_report(result, log, args.report):
+        for path in save(lambda out: write_report(result, log, out), args.report, "--report"):
             print(f"wrote {path}")
     return 0
 

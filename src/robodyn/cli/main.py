@@ -16,6 +16,8 @@ Exit status: 0 success; 2 bad input or output (the message names the file or opt
 unreadable, malformed or unphysical input, an output whose directory is missing or not
 writable, checked before the work starts); 130 interrupted (Ctrl-C); 1 an unexpected error
 (one line; ``robodyn --debug ...`` shows the traceback). A closed pipe exits quietly with 0.
+Outputs are written atomically (``robodyn.files``); one whose write fails after the work is
+saved in a new temporary directory instead (``common.save``), and the error line says where.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import sys
 import warnings
 
 from ..errors import ModelError
-from . import identification, model, simulation, symbolic
+from . import common, identification, model, simulation, symbolic
 
 
 def main(argv=None) -> int:
@@ -38,11 +40,15 @@ def main(argv=None) -> int:
         commands.add_commands(sub)
 
     args = parser.parse_args(argv)
+    common.reset()
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
             status = args.func(args)
         sys.stdout.flush()  # a closed pipe shows here, inside the try
+        if common.RESCUED:  # finished work saved elsewhere: say where, and fail
+            print(f"robodyn: error: {'; '.join(common.RESCUED)}", file=sys.stderr)
+            return 2
         return status
     except (ModelError, ValueError) as e:
         print(f"robodyn: error: {e}", file=sys.stderr)

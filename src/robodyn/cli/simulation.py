@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .common import add_model_arguments, check_output_file, load_model
+from .common import add_model_arguments, check_output_file, load_model, save, written
 
 CONTROLLERS = ("none", "pd-gravity", "computed-torque")
 
@@ -103,14 +103,14 @@ def cmd_simulate(args) -> int:
               f"largest increase over a step {max(np.diff(traj.lyapunov).max(), 0.0):.3g}")
     print(f"  applied torques: max |tau| {np.abs(traj.tau).max():.4g}")
     if args.csv:
-        traj.to_csv(args.csv)
-        print(f"  wrote {args.csv}")
+        save(traj.to_csv, args.csv, "--csv")
+        print(f"  wrote {written(args.csv)}")
     if args.plot:
-        plot_simulation(traj, args.plot)
-        print(f"  wrote {args.plot}")
+        save(lambda path: plot_simulation(traj, path), args.plot, "--plot")
+        print(f"  wrote {written(args.plot)}")
     if args.gif:
-        animate(model, traj.t, traj.q, args.gif, fps=args.fps)
-        print(f"  wrote {args.gif}")
+        save(lambda path: animate(model, traj.t, traj.q, path, fps=args.fps), args.gif, "--gif")
+        print(f"  wrote {written(args.gif)}")
     return 0
 
 
@@ -121,14 +121,14 @@ def cmd_torques(args) -> int:
     check_output_file(args.plot, "--plot")
     model = load_model(args.model, args.floating_base, args.physical)
     t, q, v, a = read_csv(model, args.trajectory)
-    data = plot_torques(model, t, q, v, a, args.plot)
+    data = save(lambda path: plot_torques(model, t, q, v, a, path), args.plot, "--plot")
     print(f"robodyn torques {model.name!r}: {t.shape[0]} samples from {args.trajectory}")
     print(f"  {'joint':<24} {'max|inertial|':>14} {'max|coriolis|':>14} {'max|gravity|':>14} {'max|total|':>14}")
     for k, name in enumerate(coordinate_names(model)[1]):
         vals = [np.abs(data[key][:, k]).max() for key in ("inertial", "coriolis", "gravity", "total")]
         print(f"  {name:<24} " + " ".join(f"{x:14.4g}" for x in vals))
     if args.plot:
-        print(f"  wrote {args.plot}")
+        print(f"  wrote {written(args.plot)}")
     return 0
 
 

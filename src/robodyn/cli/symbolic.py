@@ -5,7 +5,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import add_model_arguments, check_output_dir, check_output_file, load_model
+from .common import add_model_arguments, check_output_dir, check_output_file, load_model, save, written
 from ..files import write_text
 
 
@@ -29,12 +29,12 @@ def run_derive(model, args) -> int:
         for name in ("M", "C", "g"):
             print(f"  {name} = {eom.term(name).tolist()}")
     if args.latex:
-        write_text(args.latex, eom.latex())
-        print(f"  LaTeX: {args.latex}")
+        save(lambda path: write_text(path, eom.latex()), args.latex, "--latex")
+        print(f"  LaTeX: {written(args.latex)}")
     if args.c_dir:
-        files = eom.to_c(args.c_dir, form=args.form)
+        files = save(lambda path: eom.to_c(path, form=args.form), args.c_dir, "--c")
         how = "M, g, tau by the recursions, C expanded" if args.form == "auto" else "every term expanded"
-        print(f"  C: {', '.join(f'{args.c_dir}/{k}' for k in files)} ({how})")
+        print(f"  C: {', '.join(f'{written(args.c_dir)}/{k}' for k in files)} ({how})")
     sys.stdout.flush()
     return 0
 
