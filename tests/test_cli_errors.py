@@ -125,7 +125,7 @@ def test_results_of_a_good_run_are_written(tmp_path, capsys):
 
 
 MODEL_COMMANDS = [["info"], ["demo"], ["bench", "--no-compare"], ["simulate", "--duration", "0.01"],
-                  ["excite", "--out", "x.csv"], ["derive"]]
+                  ["torques", "t.csv"], ["excite", "--out", "x.csv"], ["identify", "d.csv"], ["derive"]]
 
 
 @pytest.mark.parametrize("command", MODEL_COMMANDS, ids=[c[0] for c in MODEL_COMMANDS])
