@@ -1,7 +1,8 @@
 """Agreement with Pinocchio on every URDF of example-robot-data, fixed and floating base.
 
 For each robot Pinocchio loads, three random states: forward kinematics, rnea (with and
-without external wrenches), aba, crba, gravity, nonlinear effects, the Coriolis matrix, the
+without external wrenches), aba, crba, the derivatives of rnea and aba (with and without
+external wrenches), gravity, nonlinear effects, the Coriolis matrix, the
 Jacobians of the last body in the three frames, the centre of mass and both energies, each to
 a relative error (max abs difference / max(1, max abs of Pinocchio's value)) below 1e-9.
 
@@ -120,10 +121,30 @@ def _compare(pair: Pair, q, v, a, f_ext, singular):
     else:
         with pytest.raises(ValueError, match="no mass"):
             rd.center_of_mass(model, q)
+    for name, wrenches in (("", ()), (" f_ext", (_pin_forces(pm, f_ext),))):
+        mine = rd.rnea_derivatives(model, q, v, a, *(f_ext for _ in wrenches), friction=False)
+        dq, dv, da = pin.computeRNEADerivatives(pm, data, qp, v, a, *wrenches)
+        for what, x, y in (("dtau_dq", mine[0], dq), ("dtau_dv", mine[1], dv), ("dtau_da", mine[2], _symmetric(da))):
+            check(what + name, x, y)
     tau = rd.rnea(model, q, v, a, friction=False)
     if singular is None:
         check("aba", rd.aba(model, q, v, tau, friction=False), pin.aba(pm, data, qp, v, tau))
         check("aba round trip", rd.aba(model, q, v, tau, friction=False), a)
+        # Both sides solve with M: each carries rounding errors up to about eps cond(M) (iCub's M
+        # has cond ~1e8); robodyn's own residual M dqdd_dq + dtau_dq = 0 is held to TOL.
+        M = rd.crba(model, q)
+        tol = max(TOL, 10 * np.finfo(float).eps * np.linalg.cond(M)) if model.nv else TOL
+        for name, wrenches in (("", ()), (" f_ext", (_pin_forces(pm, f_ext),))):
+            forces = [f_ext for _ in wrenches]
+            mine = rd.aba_derivatives(model, q, v, tau, *forces, friction=False)
+            dq, dv, dtau = pin.computeABADerivatives(pm, data, qp, v, tau, *wrenches)
+            for what, x, y in (("dqdd_dq", mine[0], dq), ("dqdd_dv", mine[1], dv),
+                               ("dqdd_dtau", mine[2], _symmetric(dtau))):
+                assert_rel(x, y, tol, what + name)
+            qdd = rd.aba(model, q, v, tau, *forces, friction=False)
+            for what, x, y in zip(("dqdd_dq", "dqdd_dv"), mine, rd.rnea_derivatives(model, q, v, qdd, *forces,
+                                                                                  friction=False)):
+                check(f"M {what} + dtau{what[4:]}{name}", M @ x, -y)
     else:
         with pytest.raises(ValueError, match=rf"body \d+ \({singular!r}, joint .*\) is singular"):
             rd.aba(model, q, v, tau, friction=False)

@@ -26,7 +26,8 @@ _LAZY = {
     "task_space_inertia": "task_space", "dynamically_consistent_inverse": "task_space",
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
-    "slotine_li_regressor": "regressor",
+    "slotine_li_regressor": "regressor", "rnea_derivatives": "rnea_derivatives",
+    "aba_derivatives": "aba_derivatives",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
@@ -70,7 +71,7 @@ __all__ = [
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
-    "slotine_li_regressor", "interop",
+    "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

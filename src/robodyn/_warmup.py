@@ -39,6 +39,8 @@ def _algorithm_steps(rd, model, q, v, a):
         ("difference", lambda: rd.difference(model, q, q)),
         ("hybrid_dynamics", lambda: rd.hybrid_dynamics(model, q, v, a, a, known)),
         ("inverse_mass_matrix", lambda: rd.inverse_mass_matrix(model, q)),
+        ("rnea_derivatives", lambda: rd.rnea_derivatives(model, q, v, a)),
+        ("aba_derivatives", lambda: rd.aba_derivatives(model, q, v, a)),
         ("constrained_dynamics", lambda: rd.constrained_dynamics(model, q, v, a, [point])),
         ("task_space_inertia", lambda: rd.task_space_inertia(model, q, last, rows="linear")),
         ("dynamically_consistent_inverse", lambda: rd.dynamically_consistent_inverse(model, q, last, rows="linear")),
@@ -77,13 +79,13 @@ def _public():
     from types import SimpleNamespace
 
     from . import random
-    from .algorithms import (aba, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian,
-                             kinematics, minv, regressor, rnea, task_space, terms)
+    from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, hybrid, integrate,
+                             jacobian, kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms)
     from .simulation import simulate
 
     names = {}
-    for module in (aba, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian, kinematics, minv,
-                   regressor, rnea, task_space, terms):
+    for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian,
+                   kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module) if not n.startswith("_")})
     return SimpleNamespace(**names, simulate=simulate, random=random)
 

@@ -42,7 +42,7 @@ from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix
                        momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
                        wrench_to_aligned)
 from . import _inputs
-from .status import raise_for_status
+from .status import raise_for_status, raise_singular
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import fits, nq_of, unpack
 from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
@@ -585,12 +585,5 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
         status = np.empty(B, dtype=np.int64)
         _aba_batch((k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd),
                    (model.nbodies, model.nv), status, chunks(B))
-    bad = raise_for_status(model, status, x, "aba")
-    if bad:
-        i = bad - 1
-        raise ValueError(
-            f"aba: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
-            f"{model.body_joint_names[i]!r}) is singular, so the forward dynamics is undefined; "
-            "give the bodies beyond it mass and inertia about the joint axis (or armature)"
-        )
+    raise_singular(model, raise_for_status(model, status, x, "aba"), "aba")
     return result

@@ -29,11 +29,10 @@ from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from . import _inputs
 from .status import raise_for_status
-from .crba import world_inertias
+from .crba import world_state
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import fits, nq_of, unpack
 from .status import OK, WRONG_SIZE, finite2, result_status
-from .kinematics import poses_checked, world_motion_subspace
 from .driver import batch_kernel, chunks
 
 
@@ -86,15 +85,13 @@ def body_B(theta, V, K, Vx, h, B):
 
 @core
 def coriolis_one(ints, body, dofs, q, v, check, C, ws):
-    _, (liR, lip, oR, op, Rj, pj), oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
+    _, P, oS, oSd, Ic, Bc, oV, K, Vx, F1, F2, F3, h = ws
     nb = ints.shape[0]
     if not (q.shape[0] == nq_of(ints) and v.shape[0] == dofs.shape[0]):
         return WRONG_SIZE
-    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    status = world_state(ints, body, dofs, q, v, check, P, oS, Ic)
     if status != OK:
         return status
-    world_motion_subspace(ints, dofs, oR, op, oS)
-    world_inertias(ints, body, oR, op, Ic)
     for i in range(nb):
         par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         for r in range(6):

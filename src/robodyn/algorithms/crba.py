@@ -54,17 +54,28 @@ def world_inertias(ints, body, oR, op, Ic):
 
 
 @inline
+def world_state(ints, body, dofs, q, v, check, P, oS, Ic):
+    """The set-up of the world-frame algorithms: placements ``P = (liR, lip, oR, op, Rj, pj)``
+    after the value checks of ``q`` and ``v`` (see ``kinematics.poses_checked``), the world
+    motion subspace columns ``oS`` and the world inertias ``Ic``; returns a status."""
+    liR, lip, oR, op, Rj, pj = P
+    status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
+    if status == OK:
+        world_motion_subspace(ints, dofs, oR, op, oS)
+        world_inertias(ints, body, oR, op, Ic)
+    return status
+
+
+@inline
 def crba_state(ints, body, dofs, q, check, M, ws):
     """``M`` (nv, nv) at ``q``; returns a status (see ``_inputs``). Inlined into
     :func:`crba_one` (one state) and :func:`crba_at` (the batch loop)."""
-    _, (liR, lip, oR, op, Rj, pj), oS, Ic, F = ws
+    _, P, oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
-    status = poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
+    status = world_state(ints, body, dofs, q, q[:0], check, P, oS, Ic)
     if status != OK:
         return status
-    world_motion_subspace(ints, dofs, oR, op, oS)
-    world_inertias(ints, body, oR, op, Ic)
     M[:, :] = 0.0
     for i in range(ints.shape[0] - 1, -1, -1):
         par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]

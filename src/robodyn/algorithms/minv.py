@@ -40,7 +40,7 @@ from ..joint_kernels import local_placement
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
 from . import _inputs
-from .status import raise_for_status
+from .status import raise_for_status, raise_singular
 from ._inputs import nq_of
 from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -217,11 +217,6 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
         B = q.shape[0]
         Minv, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
         _minv_batch((k.ints, k.body, dofs, q, check_finite, Minv), (model.nbodies, model.nv), status, chunks(B))
-    bad = raise_for_status(model, status, x, "inverse_mass_matrix")
-    if bad:
-        i = bad - 1
-        raise ValueError(
-            f"inverse_mass_matrix: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
-            f"{model.body_joint_names[i]!r}) is singular, so M(q) is singular; give the bodies beyond it mass "
-            "and inertia about the joint axis (or armature)")
+    raise_singular(model, raise_for_status(model, status, x, "inverse_mass_matrix"), "inverse_mass_matrix",
+                   "so M(q) is singular")
     return _inputs.unflatten(Minv, batch)

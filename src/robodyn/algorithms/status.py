@@ -122,3 +122,14 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
                 )
         raise AssertionError("kernel reported a bad quaternion that is not there")
     return code
+
+
+def raise_singular(model, bad: int, what: str, consequence: str = "so the forward dynamics is undefined") -> None:
+    """Raise the ``ValueError`` of a singular articulated inertia when ``bad`` (the failing body
+    + 1, as :func:`raise_for_status` returns it) is not 0."""
+    if bad:
+        i = bad - 1
+        raise ValueError(
+            f"{what}: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
+            f"{model.body_joint_names[i]!r}) is singular, {consequence}; give the bodies beyond it mass and "
+            "inertia about the joint axis (or armature)")

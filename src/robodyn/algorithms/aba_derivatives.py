@@ -1,0 +1,139 @@
+"""Analytical first derivatives of forward dynamics: ``dqdd/dq``, ``dqdd/dv`` and ``dqdd/dtau = M^-1``.
+
+Forward dynamics inverts inverse dynamics: ``rnea(q, v, aba(q, v, tau)) = tau`` for every
+``(q, v, tau)``. Differentiating this identity at ``qdd = aba(q, v, tau)``::
+
+    dtau/dq + M dqdd/dq = 0,   dtau/dv + M dqdd/dv = 0,   M dqdd/dtau = 1
+
+so ``dqdd/dq = -M^-1 dtau/dq``, ``dqdd/dv = -M^-1 dtau/dv`` and ``dqdd/dtau = M^-1``, with the
+partial derivatives of the RNEA (``rnea_derivatives.py``) taken at ``(q, v, qdd)`` and ``M^-1``
+from the O(n^2) recursion of ``minv.py`` (``M`` includes the armature when it is on; friction
+and external wrenches enter through ``dtau/dq`` and ``dtau/dv``). Derivatives with respect to
+``q`` are in the tangent space of :func:`robodyn.integrate`, as Pinocchio's
+``computeABADerivatives``.
+
+Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
+algorithms", Robotics: Science and Systems, 2018, section IV.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import boolean
+
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from . import _inputs
+from . import aba as _aba
+from . import minv as _minv
+from . import rnea_derivatives as _rd
+from ._inputs import fits, unpack
+from .driver import batch_kernel, chunks
+from .status import NO_WRENCH, OK, WRONG_SIZE, finite2, raise_for_status, raise_singular, result_status
+
+
+@kernel
+def workspace(nb, nv):
+    """Scratch of :func:`derivatives_one`: the workspaces of the ABA, the RNEA derivatives and
+    ``M^-1``, then ``(qdd, dtau_dq, dtau_dv, an empty M)``."""
+    return (_aba.workspace(nb, nv), _rd.workspace(nb, nv), _minv.workspace(nb, nv),
+            (np.empty(nv), np.empty((nv, nv)), np.empty((nv, nv)), np.empty((0, 0))))
+
+
+@inline
+def neg_product(A, B, out):
+    """``out = -A B`` for square (n, n) matrices (rows of ``B`` streamed: the inner loop is
+    contiguous)."""
+    n = A.shape[0]
+    for r in range(n):
+        for c in range(n):
+            out[r, c] = 0.0
+        for k in range(n):
+            x = A[r, k]
+            if x != 0.0:
+                for c in range(n):
+                    out[r, c] -= x * B[k, c]
+
+
+@core
+def derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv, ws):
+    """``da_dq``, ``da_dv`` and ``Minv = da_dtau`` (nv, nv) at one state; returns a status (see
+    ``_inputs``), ``i + 1`` when the articulated inertia of body ``i`` is singular."""
+    aba_ws, rd_ws, minv_ws, (qdd, dq, dv, M0) = ws
+    status = _aba.aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, aba_ws)
+    if status != OK:
+        return status
+    status = _rd.derivatives_one(ints, body, dofs, params, q, v, qdd, fext, fcode, False, dq, dv, M0, rd_ws)
+    if status != OK:
+        return status
+    status = _minv.minv_one(ints, body, dofs, q, False, Minv, minv_ws)
+    if status != OK:
+        return status
+    neg_product(Minv, dq, da_dq)
+    neg_product(Minv, dv, da_dv)
+    return result_status(check, finite2(da_dq) and finite2(da_dv))
+
+
+@inline
+def derivatives_at(args, s, ws):
+    """:func:`derivatives_one` of state ``s`` of a batch."""
+    ints, body, dofs, params, Q, V, T, F, fcode, check, DQ, DV, MI = args
+    return derivatives_one(ints, body, dofs, params, Q[s], V[s], T[s], F[s if F.shape[0] > 1 else 0], fcode, check,
+                           DQ[s], DV[s], MI[s], ws)
+
+
+_derivatives_batch = batch_kernel(derivatives_at, workspace)
+
+
+@kernel
+def _derivatives_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv):
+    return derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv,
+                           workspace(ints.shape[0], dofs.shape[0]))
+
+
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, MAT, MAT, MAT)
+def _derivatives_packed(ints, packed, q, v, tau, check, da_dq, da_dv, Minv):
+    """One state without external wrenches, the model in one array (the fast path)."""
+    body, dofs, params, zero = unpack(ints, packed)
+    nv = dofs.shape[0]
+    if not (fits(da_dq, nv, q, v, tau) and fits(da_dv, nv, q, v, tau) and fits(Minv, nv, q, v, tau)):
+        return WRONG_SIZE
+    return derivatives_one(ints, body, dofs, params, q, v, tau, zero, NO_WRENCH, check, da_dq, da_dv, Minv,
+                           workspace(ints.shape[0], nv))
+
+
+def aba_derivatives(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
+                    armature: bool = True, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Partial derivatives of forward dynamics, ``qdd = aba(q, v, tau, f_ext)``, analytical.
+
+    ``dqdd_dq = -M^-1 dtau_dq``, ``dqdd_dv = -M^-1 dtau_dv`` (the derivatives of
+    :func:`robodyn.rnea_derivatives` at ``qdd``) and ``dqdd_dtau = M^-1``; derivatives with
+    respect to ``q`` are in the tangent space of :func:`robodyn.integrate`, as Pinocchio's
+    ``computeABADerivatives``.
+
+    Args:
+        q: (..., nq). v, tau: (..., nv). f_ext, f_ext_frame, friction, armature, check_finite:
+            as in :func:`robodyn.aba`.
+
+    Returns:
+        ``(dqdd_dq, dqdd_dv, dqdd_dtau)``, each (..., nv, nv).
+
+    Raises ValueError when a body's articulated inertia is singular, as :func:`robodyn.aba`.
+    Reference: Carpentier and Mansard, RSS 2018.
+    """
+    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
+        out = _rd.fast_path(_derivatives_packed, model, q, v, tau, friction, armature, check_finite)
+        if out is not None:
+            return out
+    k, nv = model.kernel, model.nv
+    batch, x = _inputs.states(model, q=q, v=v, tau=tau)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
+    (dq, rq), (dv, rv), (Mi, rM) = (_inputs.output(None, batch, (nv, nv), x) for _ in range(3))
+    args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, dq, dv, Mi)
+    if batch == ():
+        status = _derivatives_single(*args)
+    else:
+        status = np.empty(x["q"].shape[0], dtype=np.int64)
+        _derivatives_batch(args, (model.nbodies, nv), status, chunks(status.shape[0]))
+    raise_singular(model, raise_for_status(model, status, x, "aba_derivatives"), "aba_derivatives")
+    return rq, rv, rM
