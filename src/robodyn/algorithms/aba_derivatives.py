@@ -41,17 +41,24 @@ def workspace(nb, nv):
 
 @inline
 def neg_product(A, B, out):
-    """``out = -A B`` for square (n, n) matrices (rows of ``B`` streamed: the inner loop is
-    contiguous)."""
+    """``out = -A B`` for square (n, n) matrices: row by row of ``out``, four rows of ``B`` at a
+    time (contiguous inner loops; each pass over a row of ``out`` does four multiply-adds)."""
     n = A.shape[0]
     for r in range(n):
         for c in range(n):
             out[r, c] = 0.0
-        for k in range(n):
-            x = A[r, k]
-            if x != 0.0:
+        k = 0
+        while k < n:
+            if k + 4 <= n:
+                x0, x1, x2, x3 = A[r, k], A[r, k + 1], A[r, k + 2], A[r, k + 3]
                 for c in range(n):
-                    out[r, c] -= x * B[k, c]
+                    out[r, c] -= x0 * B[k, c] + x1 * B[k + 1, c] + x2 * B[k + 2, c] + x3 * B[k + 3, c]
+                k += 4
+            else:
+                x0 = A[r, k]
+                for c in range(n):
+                    out[r, c] -= x0 * B[k, c]
+                k += 1
 
 
 @core
