@@ -30,8 +30,8 @@ _LAZY = {
     "aba_derivatives": "aba_derivatives",
 }
 # Applications, also imported on first use: name -> module.
-_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "simulation": None, "control": None,
-              "plots": None, "identification": None, "symbolic": None, "interop": None}
+_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation", "simulation": None,
+              "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None}
 
 
 def __getattr__(name):
@@ -71,7 +71,7 @@ __all__ = [
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
-    "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives",
+    "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

@@ -1,0 +1,115 @@
+"""robodyn.linearize: the (A, B) of one simulate step against differences of simulate itself
+(both integrators, fixed and floating bases, friction and armature, clipped joints), batches,
+bad input, and the LQR example (examples/lqr_acrobot.py) it serves."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from helpers import assert_rel, rng_for
+from robodyn.random import random_model, random_state
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+
+DT = 0.01
+STEP = 1e-4
+# Richardson-extrapolated central differences (steps h, h/2): error O(h^4) ~ 1e-16 times the
+# step's fifth derivative, plus rounding eps |x| / h ~ 1e-12; the tolerance keeps a margin of 100.
+TOL = 1e-8
+
+
+def one_step(model, q, v, tau, integrator):
+    """``(q+, v+)`` of :func:`robodyn.simulate` under the constant joint force ``tau``."""
+    traj = rd.simulate(model, q, v, DT, DT, lambda t, q_, v_: tau, integrator, progress=False)
+    return traj.q[-1], traj.v[-1]
+
+
+def by_differences(model, q, v, tau, integrator):
+    q1, v1 = one_step(model, q, v, tau, integrator)
+    n = model.nv
+
+    def moved(k, d):
+        e = np.zeros(n)
+        e[k % n] = d
+        x = (rd.integrate(model, q, e), v, tau) if k < n else (q, v + e, tau) if k < 2 * n else (q, v, tau + e)
+        qp, vp = one_step(model, *x, integrator)
+        return np.concatenate([rd.difference(model, q1, qp), vp - v1])
+
+    cols = []
+    for k in range(3 * n):
+        d = [(moved(k, h) - moved(k, -h)) / (2 * h) for h in (STEP, STEP / 2)]
+        cols.append((4 * d[1] - d[0]) / 3)
+    J = np.stack(cols, -1)
+    return J[:, :2 * n], J[:, 2 * n:]
+
+
+CASES = [(4, 1, False, "semi_implicit_euler"), (4, 1, False, "rk4"), (5, 2, True, "semi_implicit_euler"),
+         (3, 3, True, "semi_implicit_euler")]
+
+
+@pytest.mark.parametrize("n, seed, floating_base, integrator", CASES)
+def test_against_differences_of_simulate(n, seed, floating_base, integrator):
+    rng = rng_for("linearize", n, seed, floating_base, integrator)
+    base = random_model(n, seed=seed, floating_base=floating_base, branching=0.5)
+    model = base.replace(damping=rng.uniform(0.1, 1.0, base.nv), armature=rng.uniform(0.01, 0.1, base.nv))
+    q, v, tau = random_state(model, rng)
+    A, B = rd.linearize(model, q, v, tau, DT, integrator)
+    fd_A, fd_B = by_differences(model, q, v, tau, integrator)
+    assert A.shape == (2 * model.nv, 2 * model.nv) and B.shape == (2 * model.nv, model.nv)
+    assert_rel(A, fd_A, TOL, "A")
+    assert_rel(B, fd_B, TOL, "B")
+
+
+def test_clipped_joints_have_no_input():
+    model = random_model(3, seed=4)
+    q, v, tau = random_state(model, rng_for("clip"))
+    limited = model.replace(effort_limit=np.abs(tau) * np.array([2.0, 0.5, 2.0]))  # joint 1 saturates
+    A, B = rd.linearize(limited, q, v, tau, DT)
+    fd_A, fd_B = by_differences(limited, q, v, tau, "semi_implicit_euler")
+    assert_rel(A, fd_A, TOL, "A")
+    assert_rel(B, fd_B, TOL, "B")
+    assert np.all(B[:, 1] == 0) and np.all(B[:, [0, 2]] != 0)
+
+
+def test_batch():
+    model = random_model(4, seed=5, floating_base=True)
+    Q, V, T = random_state(model, rng_for("batch"), (2, 3))
+    A, B = rd.linearize(model, Q, V, T, DT)
+    assert A.shape == (2, 3, 2 * model.nv, 2 * model.nv) and B.shape == (2, 3, 2 * model.nv, model.nv)
+    for i in np.ndindex(2, 3):
+        a, b = rd.linearize(model, Q[i], V[i], T[i], DT)
+        assert_rel(A[i], a, 1e-12)
+        assert_rel(B[i], b, 1e-12)
+
+
+def test_bad_input():
+    model = random_model(3, seed=6, floating_base=True)
+    q, v, tau = random_state(model, rng_for("bad"))
+    with pytest.raises(ValueError, match="integrator: unknown 'euler'"):
+        rd.linearize(model, q, v, tau, DT, "euler")
+    for dt in (0.0, -1.0, np.nan, "0.1"):
+        with pytest.raises(ValueError, match="dt: expected a positive number"):
+            rd.linearize(model, q, v, tau, dt)
+    with pytest.raises(ValueError, match="rk4' needs joints of one dof; 'root_joint' is a free joint"):
+        rd.linearize(model, q, v, tau, DT, "rk4")
+    with pytest.raises(ValueError, match=r"\bv\b.*NaN"):
+        rd.linearize(model, q, np.full(model.nv, np.nan), tau, DT)
+    with pytest.raises(ValueError, match=r"\btau\b"):
+        rd.linearize(model, q, v, tau[:-1], DT)
+
+
+def test_lqr_acrobot_example_keeps_the_acrobot_upright():
+    import lqr_acrobot
+
+    model = rd.models.load("double_pendulum")
+    _, eigenvalues = lqr_acrobot.lqr_gain(model)
+    assert np.abs(eigenvalues).max() < 1.0
+    traj = lqr_acrobot.run()
+    assert np.abs(traj.q).max() > 0.1  # the push moved it
+    assert np.abs(traj.q[-1]).max() < 1e-6 and np.abs(traj.v[-1]).max() < 1e-6
+    assert np.all(traj.tau[:, 0] == 0)  # the shoulder has no motor
