@@ -113,3 +113,18 @@ def test_lqr_acrobot_example_keeps_the_acrobot_upright():
     assert np.abs(traj.q).max() > 0.1  # the push moved it
     assert np.abs(traj.q[-1]).max() < 1e-6 and np.abs(traj.v[-1]).max() < 1e-6
     assert np.all(traj.tau[:, 0] == 0)  # the shoulder has no motor
+
+
+def test_ilqr_example_swings_the_double_pendulum_up():
+    import ilqr_double_pendulum as ex
+
+    X, U, costs = ex.swing_up()
+    assert np.all(np.diff(costs) < 0)  # every accepted iteration lowers the cost
+    assert costs[-1] < 1e-3 * costs[0]
+    assert np.abs(X[-1]).max() < 0.01  # upright at rest at the end
+    # the example's rollout is the simulator's semi-implicit Euler step under the held inputs
+    model = rd.models.load("double_pendulum")
+    traj = rd.simulate(model, X[0, :2], X[0, 2:], ex.DT * ex.HORIZON, ex.DT,
+                       lambda t, q, v: U[min(int(round(t / ex.DT)), ex.HORIZON - 1)], "semi_implicit_euler",
+                       progress=False)
+    assert_rel(np.hstack([traj.q, traj.v]), X, 1e-9)
