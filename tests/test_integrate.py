@@ -123,3 +123,93 @@ def test_bad_input():
         rd.integrate(model, bad, v)
     with pytest.raises(ValueError, match=r"do not broadcast"):
         rd.difference(model, np.stack([q, q]), np.stack([q, q, q]))
+
+
+# -- Jacobians of integrate and difference ------------------------------------------------------
+def _pin_jacobians(pm, q, v, q1):
+    arg0, arg1 = pin.ArgumentPosition.ARG0, pin.ArgumentPosition.ARG1
+    return (pin.dIntegrate(pm, q, v, arg0), pin.dIntegrate(pm, q, v, arg1), pin.dDifference(pm, q, q1, arg0),
+            pin.dDifference(pm, q, q1, arg1))
+
+
+@random_models
+def test_jacobians_agree_with_pinocchio(model):
+    pm = pin_model_with_same_joints(model)
+    rng = rng_for(model.name, "jacobians")
+    for scale in (0.0, 1e-7, 1.0, 3.0):  # the series branches and large rotations
+        q, q1 = random_configuration(model, rng), random_configuration(model, rng)
+        v = scale * rng.standard_normal(model.nv)
+        if scale == 0.0:
+            q1 = q.copy()
+        mine = rd.integrate_jacobians(model, q, v) + rd.difference_jacobians(model, q, q1)
+        for name, x, y in zip(("dq", "dv", "d0", "d1"), mine, _pin_jacobians(pm, q, v, q1)):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-11, err_msg=name)
+
+
+@random_models
+def test_jacobians_are_the_differences(model):
+    """Richardson-extrapolated central differences along the tangent directions: error
+    O(h^4) times the fifth derivative (up to ~1e-9 at h = 1e-3 for twists of a few radians)
+    plus eps / h ~ 1e-13; the tolerance leaves a factor of 10."""
+    rng = rng_for(model.name, "jacobian-differences")
+    q, q1 = random_configuration(model, rng), random_configuration(model, rng)
+    v = rng.standard_normal(model.nv)
+    n = model.nv
+
+    def derivative(f):
+        cols = []
+        for k in range(n):
+            e = np.zeros(n)
+            e[k] = 1.0
+            d = [(f(h * e) - f(-h * e)) / (2 * h) for h in (1e-3, 5e-4)]
+            cols.append((4 * d[1] - d[0]) / 3)
+        return np.stack(cols, -1)
+
+    out, d = rd.integrate(model, q, v), rd.difference(model, q, q1)
+    Jq, Jv = rd.integrate_jacobians(model, q, v)
+    J0, J1 = rd.difference_jacobians(model, q, q1)
+    fd = [derivative(lambda e: rd.difference(model, out, rd.integrate(model, rd.integrate(model, q, e), v))),
+          derivative(lambda e: rd.difference(model, out, rd.integrate(model, q, v + e))),
+          derivative(lambda e: rd.difference(model, rd.integrate(model, q, e), q1) - d),
+          derivative(lambda e: rd.difference(model, q, rd.integrate(model, q1, e)) - d)]
+    for name, x, y in zip(("dq", "dv", "d0", "d1"), (Jq, Jv, J0, J1), fd):
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-8, err_msg=name)
+
+
+@pytest.mark.parametrize("path", FLOATING_URDFS[:1])
+def test_jacobians_on_a_floating_urdf_agree_with_pinocchio(path):
+    full = str(example_robot_data_dir() / path)
+    pm = pin.buildModelFromUrdf(full, pin.JointModelFreeFlyer())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        model = rd.load_urdf(full, floating_base=True, physical="warn")
+    rng = rng_for(path, "jacobians")
+    q, q1 = random_configuration(model, rng), random_configuration(model, rng)
+    v = rng.standard_normal(model.nv)
+    mine = rd.integrate_jacobians(model, q, v) + rd.difference_jacobians(model, q, q1)
+    for name, x, y in zip(("dq", "dv", "d0", "d1"), mine, _pin_jacobians(pm, q, v, q1)):
+        np.testing.assert_allclose(x, y, rtol=0, atol=1e-11, err_msg=name)
+
+
+def test_jacobians_batch_and_bad_input():
+    model = RANDOM_MODELS[RANDOM_IDS.index("n7-seed5-floating-br0.3")]
+    rng = rng_for("jacobian-batch")
+    q, v = random_configuration(model, rng, (2, 3)), rng.standard_normal((2, 3, model.nv))
+    Jq, Jv = rd.integrate_jacobians(model, q, v)
+    J0, J1 = rd.difference_jacobians(model, q[0, 0], q)
+    assert Jq.shape == Jv.shape == J0.shape == J1.shape == (2, 3, model.nv, model.nv)
+    for i in np.ndindex(2, 3):
+        for x, y in zip((Jq[i], Jv[i]), rd.integrate_jacobians(model, q[i], v[i])):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-15)
+        for x, y in zip((J0[i], J1[i]), rd.difference_jacobians(model, q[0, 0], q[i])):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-15)
+    with pytest.raises(ValueError, match=rf"v: expected shape \(\.\.\., {model.nv}\)"):
+        rd.integrate_jacobians(model, q[0, 0], np.zeros(2))
+    with pytest.raises(ValueError, match=r"v contains NaN"):
+        rd.integrate_jacobians(model, q[0, 0], np.full(model.nv, np.nan))
+    with pytest.raises(ValueError, match=r"q1 contains NaN"):
+        rd.difference_jacobians(model, q[0, 0], np.full(model.nq, np.nan))
+    bad = q[0, 0].copy()
+    bad[3:7] *= 2.0
+    with pytest.raises(ValueError, match=r"quaternion q\[3:7\] has norm 2, not 1"):
+        rd.integrate_jacobians(model, bad, v[0, 0])

@@ -37,6 +37,8 @@ def _algorithm_steps(rd, model, q, v, a):
         ("frame_pose", lambda: rd.frame_pose(model, q, model.link_names[last])),
         ("integrate", lambda: rd.integrate(model, q, v)),
         ("difference", lambda: rd.difference(model, q, q)),
+        ("integrate_jacobians", lambda: rd.integrate_jacobians(model, q, v)),
+        ("difference_jacobians", lambda: rd.difference_jacobians(model, q, q)),
         ("hybrid_dynamics", lambda: rd.hybrid_dynamics(model, q, v, a, a, known)),
         ("inverse_mass_matrix", lambda: rd.inverse_mass_matrix(model, q)),
         ("rnea_derivatives", lambda: rd.rnea_derivatives(model, q, v, a)),

@@ -154,6 +154,88 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
     return require_finite_result("difference", d, check_finite, {"q0": q0, "q1": q1})
 
 
+def _series(t, f, *coefficients):
+    """``f(ts)`` where ``t >= _SMALL``, else the series ``c0 + c1 t^2 + ...`` (``t`` (...,))."""
+    small = t < _SMALL
+    ts = np.where(small, 1.0, t)
+    return np.where(small, sum(c * t ** (2 * k) for k, c in enumerate(coefficients)), f(ts))
+
+
+def _right_jacobian_so3(w):
+    """``Jr(w) = 1 - (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2`` (..., 3, 3): the right
+    Jacobian of SO(3), ``exp(w + d) = exp(w) exp(Jr(w) d)`` to first order."""
+    a, b = _coefficients(np.linalg.norm(w, axis=-1))
+    W = _skew(w)
+    return np.eye(3) - a[..., None, None] * W + b[..., None, None] * (W @ W)
+
+
+def right_jacobian_se3(xi):
+    """``Jr(xi)`` (..., 6, 6) of SE(3), ``exp(xi + d) = exp(xi) exp(Jr(xi) d)`` to first order,
+    for ``xi = [v_lin, omega]``: ``[[Jr3(w), Q(-v, -w)], [0, Jr3(w)]]`` with Barfoot's ``Q``
+    (*State Estimation for Robotics*, 2017, eq. 7.86; ``Jr(xi) = Jl(-xi)``)."""
+    rho, phi = -xi[..., :3], -xi[..., 3:]
+    t = np.linalg.norm(phi, axis=-1)
+    c1 = _series(t, lambda x: (x - np.sin(x)) / x ** 3, 1 / 6, -1 / 120)
+    c2 = _series(t, lambda x: (x * x + 2 * np.cos(x) - 2) / (2 * x ** 4), 1 / 24, -1 / 720)
+    c3 = _series(t, lambda x: (2 * x - 3 * np.sin(x) + x * np.cos(x)) / (2 * x ** 5), 1 / 120, -1 / 2520)
+    P, R = _skew(phi), _skew(rho)
+    PR, RP, PRP = P @ R, R @ P, P @ R @ P
+    Q = (0.5 * R + c1[..., None, None] * (PR + RP + PRP) + c2[..., None, None] * (P @ PR + RP @ P - 3 * PRP)
+         + c3[..., None, None] * (PRP @ P + P @ PRP))
+    J3 = _right_jacobian_so3(xi[..., 3:])
+    out = np.zeros(xi.shape[:-1] + (6, 6))
+    out[..., :3, :3], out[..., :3, 3:], out[..., 3:, 3:] = J3, Q, J3
+    return out
+
+
+def _inverse_adjoint(quat, p):
+    """``Ad((R, p))^-1 = [[R^T, -R^T [p]x], [0, R^T]]`` (..., 6, 6) on motions ``[v; w]``."""
+    Rt = np.swapaxes(_quat_matrix(quat), -1, -2)
+    out = np.zeros(quat.shape[:-1] + (6, 6))
+    out[..., :3, :3], out[..., :3, 3:], out[..., 3:, 3:] = Rt, -Rt @ _skew(p), Rt
+    return out
+
+
+def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobians of ``q ⊕ v`` (:func:`integrate`) in tangent coordinates: ``(J_q, J_v)``, each
+    (..., nv, nv), with ``integrate(q ⊕ dq, v + dv) = integrate(q, v) ⊕ (J_q dq + J_v dv)`` to
+    first order (Pinocchio's ``dIntegrate``, arguments 0 and 1).
+
+    1-dof joints: identity blocks. A free joint: ``J_q = Ad(exp(v))^-1``, ``J_v = Jr(v)``, the
+    right Jacobian of SE(3) (:func:`right_jacobian_se3`). Reference: Sola, Deray and Atchuthan,
+    "A micro Lie theory for state estimation in robotics" (2018), eqs. (68)-(69).
+    """
+    batch, x = _inputs.states(model, q=q, v=v)
+    q, v = x["q"], x["v"]
+    _check(model, check_finite, "integrate_jacobians", q=q, v=v)
+    Jq = np.broadcast_to(np.eye(model.nv), q.shape[:-1] + (model.nv, model.nv)).copy()
+    Jv = Jq.copy()
+    for _, kv in _free_blocks(model):
+        xi = v[..., kv:kv + 6]
+        quat, p = exp_se3(xi)
+        Jq[..., kv:kv + 6, kv:kv + 6] = _inverse_adjoint(quat, p)
+        Jv[..., kv:kv + 6, kv:kv + 6] = right_jacobian_se3(xi)
+    return _inputs.unflatten(Jq, batch), _inputs.unflatten(Jv, batch)
+
+
+def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Jacobians of ``d = q1 ⊖ q0`` (:func:`difference`) in tangent coordinates: ``(J_0, J_1)``,
+    each (..., nv, nv), with ``(q1 ⊕ d1) ⊖ (q0 ⊕ d0) = d + J_0 d0 + J_1 d1`` to first order
+    (Pinocchio's ``dDifference``, arguments 0 and 1).
+
+    1-dof joints: ``-1`` and ``1``. A free joint: ``J_1 = Jr(d)^-1`` and ``J_0 = -Jr(-d)^-1``
+    (the inverse left Jacobian). Reference: Sola et al. (2018), eqs. (75)-(76) and (79).
+    """
+    d = difference(model, q0, q1, check_finite=check_finite)
+    J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
+    J0 = -J1
+    for _, kv in _free_blocks(model):
+        xi = d[..., kv:kv + 6]
+        J1[..., kv:kv + 6, kv:kv + 6] = np.linalg.inv(right_jacobian_se3(xi))
+        J0[..., kv:kv + 6, kv:kv + 6] = -np.linalg.inv(right_jacobian_se3(-xi))
+    return J0, J1
+
+
 def _as_configuration(model, name: str, a) -> np.ndarray:
     try:
         a = np.asarray(a, dtype=float)
