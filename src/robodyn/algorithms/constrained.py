@@ -32,6 +32,7 @@ from typing import NamedTuple, Sequence
 import numpy as np
 
 from .. import joints as Jt
+from ..lie import skew
 from . import _inputs
 from .crba import crba
 from .jacobian import jacobian_pass, moving_frame
@@ -71,14 +72,6 @@ class FrameKinematics(NamedTuple):
     acc_ang: np.ndarray
 
 
-def _skew(x: np.ndarray) -> np.ndarray:
-    """``[x]x`` (B, 3, 3) of vectors (B, 3)."""
-    S = np.zeros(x.shape[:-1] + (3, 3))
-    S[..., 0, 1], S[..., 0, 2], S[..., 1, 2] = -x[..., 2], x[..., 1], -x[..., 0]
-    S[..., 1, 0], S[..., 2, 0], S[..., 2, 1] = x[..., 2], -x[..., 1], x[..., 0]
-    return S
-
-
 def _mv(A: np.ndarray, x: np.ndarray) -> np.ndarray:
     return (A @ x[..., None])[..., 0]
 
@@ -107,7 +100,7 @@ def frame_kinematics(model, q, v, body, point=(0.0, 0.0, 0.0)) -> FrameKinematic
     x = op + oR @ r
     w, alpha = vel[:, 3:], acc[:, 3:]
     a_body = acc[:, :3] + np.cross(alpha, r) + np.cross(w, vel[:, :3] + np.cross(w, r))
-    return FrameKinematics(oR @ R_bf, x, oJ[:, :3] - _skew(x) @ oJ[:, 3:], oJ[:, 3:], _mv(oR, a_body), _mv(oR, alpha))
+    return FrameKinematics(oR @ R_bf, x, oJ[:, :3] - skew(x) @ oJ[:, 3:], oJ[:, 3:], _mv(oR, a_body), _mv(oR, alpha))
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,72 +20,9 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
+from ..lie import exp_se3, inverse_adjoint, log_se3, quat_matrix, quat_mul, right_jacobian_se3
 from . import _inputs
 from .status import require_finite_result
-
-# Below this angle the series expansions of the exponential's coefficients are used.
-_SMALL = 1e-4
-
-
-def _skew(w: np.ndarray) -> np.ndarray:
-    """``[w]x`` (..., 3, 3)."""
-    z = np.zeros(w.shape[:-1])
-    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1),
-                     np.stack([w[..., 2], z, -w[..., 0]], -1),
-                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
-
-
-def _quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton product of quaternions ``(x, y, z, w)`` (..., 4)."""
-    av, aw, bv, bw = a[..., :3], a[..., 3:], b[..., :3], b[..., 3:]
-    return np.concatenate([aw * bv + bw * av + np.cross(av, bv), aw * bw - np.sum(av * bv, -1, keepdims=True)], -1)
-
-
-def _quat_matrix(quat: np.ndarray) -> np.ndarray:
-    x, y, z, w = np.moveaxis(quat / np.linalg.norm(quat, axis=-1, keepdims=True), -1, 0)
-    return np.stack([np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
-                     np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
-                     np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1)], -2)
-
-
-def _coefficients(t: np.ndarray):
-    """``(1 - cos t) / t^2`` and ``(t - sin t) / t^3`` (series below ``_SMALL``)."""
-    small = t < _SMALL
-    ts = np.where(small, 1.0, t)
-    a = np.where(small, 0.5 - t * t / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
-    b = np.where(small, 1.0 / 6.0 - t * t / 120.0, (ts - np.sin(ts)) / ts ** 3)
-    return a, b
-
-
-def exp_se3(xi: np.ndarray):
-    """Quaternion (..., 4) and translation (..., 3) of ``exp(xi)``, ``xi = [v_lin, omega]``."""
-    v, w = xi[..., :3], xi[..., 3:]
-    t = np.linalg.norm(w, axis=-1)
-    half = 0.5 * t
-    small = t < _SMALL
-    sinc_half = np.where(small, 0.5 - t * t / 48.0, np.sin(half) / np.where(small, 1.0, t))
-    quat = np.concatenate([sinc_half[..., None] * w, np.cos(half)[..., None]], -1)
-    a, b = _coefficients(t)
-    wx = np.cross(w, v)
-    p = v + a[..., None] * wx + b[..., None] * np.cross(w, wx)
-    return quat, p
-
-
-def log_se3(quat: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """``[v_lin, omega]`` (..., 6) with ``exp_se3`` giving the pose ``(quat, p)``, ``|omega| <= pi``."""
-    quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
-    quat = np.where(quat[..., 3:] < 0, -quat, quat)  # the shorter rotation
-    s = np.linalg.norm(quat[..., :3], axis=-1)
-    t = 2.0 * np.arctan2(s, quat[..., 3])
-    small = t < _SMALL
-    w = quat[..., :3] * np.where(small, 2.0 + t * t / 12.0, t / np.where(small, 1.0, s))[..., None]
-    # V(w)^-1 = I - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2
-    ts = np.where(small, 1.0, t)
-    c = np.where(small, 1.0 / 12.0 + t * t / 720.0, (1.0 - ts * np.sin(ts) / (2.0 * (1.0 - np.cos(ts)))) / ts ** 2)
-    wp = np.cross(w, p)
-    v = p - 0.5 * wp + c[..., None] * np.cross(w, wp)
-    return np.concatenate([v, w], -1)
-
 
 def _free_blocks(model):
     for i in np.flatnonzero(model.joint_type == J.FREE):
@@ -120,8 +57,8 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     for kq, kv in _free_blocks(model):
         quat0 = q[..., kq + 3:kq + 7] / np.linalg.norm(q[..., kq + 3:kq + 7], axis=-1, keepdims=True)
         dquat, dp = exp_se3(v[..., kv:kv + 6])
-        out[..., kq:kq + 3] = q[..., kq:kq + 3] + np.einsum("...ij,...j->...i", _quat_matrix(quat0), dp)
-        quat = _quat_mul(quat0, dquat)
+        out[..., kq:kq + 3] = q[..., kq:kq + 3] + np.einsum("...ij,...j->...i", quat_matrix(quat0), dp)
+        quat = quat_mul(quat0, dquat)
         quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
         out[..., kq + 3:kq + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
     require_finite_result("integrate", out, check_finite, {"q": q, "v": v})
@@ -149,51 +86,9 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
         quat0, quat1 = q0[..., kq + 3:kq + 7], q1[..., kq + 3:kq + 7]
         quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
         conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
-        dp = np.einsum("...ji,...j->...i", _quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
-        d[..., kv:kv + 6] = log_se3(_quat_mul(conj0, quat1), dp)
+        dp = np.einsum("...ji,...j->...i", quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
+        d[..., kv:kv + 6] = log_se3(quat_mul(conj0, quat1), dp)
     return require_finite_result("difference", d, check_finite, {"q0": q0, "q1": q1})
-
-
-def _series(t, f, *coefficients):
-    """``f(ts)`` where ``t >= _SMALL``, else the series ``c0 + c1 t^2 + ...`` (``t`` (...,))."""
-    small = t < _SMALL
-    ts = np.where(small, 1.0, t)
-    return np.where(small, sum(c * t ** (2 * k) for k, c in enumerate(coefficients)), f(ts))
-
-
-def _right_jacobian_so3(w):
-    """``Jr(w) = 1 - (1 - cos t) / t^2 [w]x + (t - sin t) / t^3 [w]x^2`` (..., 3, 3): the right
-    Jacobian of SO(3), ``exp(w + d) = exp(w) exp(Jr(w) d)`` to first order."""
-    a, b = _coefficients(np.linalg.norm(w, axis=-1))
-    W = _skew(w)
-    return np.eye(3) - a[..., None, None] * W + b[..., None, None] * (W @ W)
-
-
-def right_jacobian_se3(xi):
-    """``Jr(xi)`` (..., 6, 6) of SE(3), ``exp(xi + d) = exp(xi) exp(Jr(xi) d)`` to first order,
-    for ``xi = [v_lin, omega]``: ``[[Jr3(w), Q(-v, -w)], [0, Jr3(w)]]`` with Barfoot's ``Q``
-    (*State Estimation for Robotics*, 2017, eq. 7.86; ``Jr(xi) = Jl(-xi)``)."""
-    rho, phi = -xi[..., :3], -xi[..., 3:]
-    t = np.linalg.norm(phi, axis=-1)
-    c1 = _series(t, lambda x: (x - np.sin(x)) / x ** 3, 1 / 6, -1 / 120)
-    c2 = _series(t, lambda x: (x * x + 2 * np.cos(x) - 2) / (2 * x ** 4), 1 / 24, -1 / 720)
-    c3 = _series(t, lambda x: (2 * x - 3 * np.sin(x) + x * np.cos(x)) / (2 * x ** 5), 1 / 120, -1 / 2520)
-    P, R = _skew(phi), _skew(rho)
-    PR, RP, PRP = P @ R, R @ P, P @ R @ P
-    Q = (0.5 * R + c1[..., None, None] * (PR + RP + PRP) + c2[..., None, None] * (P @ PR + RP @ P - 3 * PRP)
-         + c3[..., None, None] * (PRP @ P + P @ PRP))
-    J3 = _right_jacobian_so3(xi[..., 3:])
-    out = np.zeros(xi.shape[:-1] + (6, 6))
-    out[..., :3, :3], out[..., :3, 3:], out[..., 3:, 3:] = J3, Q, J3
-    return out
-
-
-def _inverse_adjoint(quat, p):
-    """``Ad((R, p))^-1 = [[R^T, -R^T [p]x], [0, R^T]]`` (..., 6, 6) on motions ``[v; w]``."""
-    Rt = np.swapaxes(_quat_matrix(quat), -1, -2)
-    out = np.zeros(quat.shape[:-1] + (6, 6))
-    out[..., :3, :3], out[..., :3, 3:], out[..., 3:, 3:] = Rt, -Rt @ _skew(p), Rt
-    return out
 
 
 def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -202,7 +97,7 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     first order (Pinocchio's ``dIntegrate``, arguments 0 and 1).
 
     1-dof joints: identity blocks. A free joint: ``J_q = Ad(exp(v))^-1``, ``J_v = Jr(v)``, the
-    right Jacobian of SE(3) (:func:`right_jacobian_se3`). Reference: Sola, Deray and Atchuthan,
+    right Jacobian of SE(3) (:func:`robodyn.lie.right_jacobian_se3`). Reference: Sola, Deray and Atchuthan,
     "A micro Lie theory for state estimation in robotics" (2018), eqs. (68)-(69).
     """
     batch, x = _inputs.states(model, q=q, v=v)
@@ -213,7 +108,7 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     for _, kv in _free_blocks(model):
         xi = v[..., kv:kv + 6]
         quat, p = exp_se3(xi)
-        Jq[..., kv:kv + 6, kv:kv + 6] = _inverse_adjoint(quat, p)
+        Jq[..., kv:kv + 6, kv:kv + 6] = inverse_adjoint(quat, p)
         Jv[..., kv:kv + 6, kv:kv + 6] = right_jacobian_se3(xi)
     return _inputs.unflatten(Jq, batch), _inputs.unflatten(Jv, batch)
 

@@ -32,29 +32,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
+from ..lie import exp_so3, right_jacobian_so3, skew
 from .simulate import INTEGRATORS
-
-
-def _skew(w):
-    """``[w]x`` (..., 3, 3)."""
-    z = np.zeros(w.shape[:-1])
-    return np.stack([np.stack([z, -w[..., 2], w[..., 1]], -1), np.stack([w[..., 2], z, -w[..., 0]], -1),
-                     np.stack([-w[..., 1], w[..., 0], z], -1)], -2)
-
-
-def _so3(phi):
-    """``(exp(phi), Jr(phi))`` (..., 3, 3): Rodrigues' formula and the right Jacobian
-    ``Jr = 1 - (1 - cos t) / t^2 [phi]x + (t - sin t) / t^3 [phi]x^2`` (series for small ``t``)."""
-    t = np.linalg.norm(phi, axis=-1)[..., None, None]
-    small = t < 1e-4
-    ts = np.where(small, 1.0, t)
-    s = np.where(small, 1.0 - t * t / 6.0, np.sin(ts) / ts)
-    c = np.where(small, 0.5 - t * t / 24.0, (1.0 - np.cos(ts)) / ts ** 2)
-    d = np.where(small, 1.0 / 6.0 - t * t / 120.0, (ts - np.sin(ts)) / ts ** 3)
-    K = _skew(phi)
-    K2 = K @ K
-    eye = np.eye(3)
-    return eye + s * K + c * K2, eye - c * K + d * K2
 
 
 def _acceleration_derivatives(model, q, v, tau):
@@ -118,10 +97,10 @@ def _semi_implicit_euler(model, q, v, tau, dt, free):
     for i in free:
         k = model.idx_v[i]
         lin, ang = slice(k, k + 3), slice(k + 3, k + 6)
-        E, Jr = _so3(dt * v_next[..., ang])
+        E, Jr = exp_so3(dt * v_next[..., ang]), right_jacobian_so3(dt * v_next[..., ang])
         Et = np.swapaxes(E, -1, -2)
         Gq[..., lin, lin] = Et
-        Gq[..., lin, ang] = -dt * Et @ _skew(v_next[..., lin])
+        Gq[..., lin, ang] = -dt * Et @ skew(v_next[..., lin])
         Gq[..., ang, ang] = Et
         Gv[..., lin, lin] = dt * Et
         Gv[..., ang, ang] = dt * Jr
