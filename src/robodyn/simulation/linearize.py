@@ -3,28 +3,34 @@
 The state ``x = (q, v)`` is perturbed in tangent coordinates, ``q ⊕ dq`` (:func:`robodyn.integrate`,
 a body twist for a free joint) and ``v + dv``; the next state's perturbation is measured the same
 way at ``x+``. The input ``u`` is the joint force held over the step (clipped to the model's
-effort limits, as :func:`simulate` does). With ``Aq, Av, Bu`` the derivatives of the
-acceleration (:func:`robodyn.aba_derivatives`, ``Bu = M^-1`` on the joints below their limit):
+effort limits, as :func:`simulate` does).
 
-* ``"semi_implicit_euler"``: ``v+ = v + dt a(q, v, u)``, ``q+ = q ⊞ dt v+`` (the simulator's
-  chart: ``q + dt v+`` for 1-dof joints; a free joint's position ``p + dt R v_lin+`` and
-  orientation ``R exp(dt w+)``), so::
+A step of :func:`simulate` integrates in the chart ``q = q0 ⊞ theta`` centred at the step's start
+``q0`` (``_kernels.py``): ``q0 + theta`` for 1-dof joints; for a free joint the position
+``p0 + theta_p`` and the orientation ``R0 exp(phi)``, with the chart's rate
+``k(q0, theta, v) = [R v_lin; Jr(phi)^-1 omega]`` (``R = R0 exp(phi)``, ``Jr`` the right
+Jacobian of SO(3), ``Jr^-1 w = w + phi x w / 2 + c(t) phi x (phi x w)``,
+``c(t) = (1 - (t / 2) cot(t / 2)) / t^2``, ``t = |phi|``). Its derivatives, for a free joint
+(``E = exp(phi)``; 1-dof joints: ``Dq0 = Dth = Kv = 1``, ``Kq = Kth = 0``):
 
-      dv+ = dt Aq dq + (1 + dt Av) dv + dt Bu du,     dq+ = Gq dq + Gv dv+
+    tangent of q0 ⊞ theta:   Dq0 = d/dq0 = diag(E^T, E^T),   Dth = d/dtheta = diag(R^T, Jr(phi))
+    rate:   Kq = d/dq0 = [[0, -R [v_lin]x E^T], [0, 0]],    Kv = d/dv = diag(R, Jr(phi)^-1)
+            Kth = d/dtheta = [[0, -R [v_lin]x Jr(phi)], [0, d(Jr(phi)^-1 w)/dphi]]
+    d(Jr^-1 w)/dphi = -[w]x / 2 + c ((phi . w) 1 + phi w^T - 2 w phi^T) + (c'/t) (phi x (phi x w)) phi^T
 
-  with ``Gq = 1``, ``Gv = dt 1`` for 1-dof joints and, for a free joint (``E = exp(dt w+)``,
-  ``Jr`` the right Jacobian of SO(3))::
+With ``Aq, Av, Bu`` the derivatives of the acceleration (:func:`robodyn.aba_derivatives`,
+``Bu = M^-1`` on the joints below their limit), every quantity of the step is differentiated
+along ``(dq, dv, du)``:
 
-      Gq = [[E^T, -dt E^T [v_lin+]x], [0, E^T]],     Gv = [[dt E^T, 0], [0, dt Jr(dt w+)]]
+* ``"semi_implicit_euler"``: ``v+ = v + dt a(q0, v, u)``, ``theta+ = dt k(q0, 0, v+)``;
+* ``"rk4"``: stages ``theta_j = c_j dt k_{j-1}``, ``v_j = v + c_j dt a_{j-1}`` (``c = 0, 1/2,
+  1/2, 1``) at ``q_j = q0 ⊞ theta_j``, then ``theta+ = dt/6 (k_1 + 2 k_2 + 2 k_3 + k_4)`` and
+  ``v+ = v + dt/6 (a_1 + 2 a_2 + 2 a_3 + a_4)``;
 
-* ``"rk4"``: the classic Runge-Kutta method on ``(q, v)`` (models whose joints all have one
-  dof, where the chart is ``q + theta``): each stage's Jacobian ``K_j = F_j (1 + c_j dt K_{j-1})``
-  with ``F_j = [[0, 1], [Aq_j, Av_j]]`` at the stage's state, and ``A = 1 + dt/6 (K_1 + 2 K_2
-  + 2 K_3 + K_4)`` (likewise for ``B``).
-
-Both are exact derivatives of the step :func:`simulate` takes (not of the continuous dynamics).
-Reference: Hairer, Lubich, Wanner, *Geometric Numerical Integration* (2006), IV.8; the right
-Jacobian of SO(3): Barfoot, *State Estimation for Robotics* (2017), section 7.1.5.
+and ``dq+ = Dq0(theta+) dq + Dth(theta+) dtheta+``. Both are exact derivatives of the step
+:func:`simulate` takes (not of the continuous dynamics). Reference: Hairer, Lubich, Wanner,
+*Geometric Numerical Integration* (2006), IV.8 (Runge-Kutta-Munthe-Kaas); Barfoot, *State
+Estimation for Robotics* (2017), section 7.1 (the Jacobians of SO(3)).
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
-from ..lie import exp_so3, right_jacobian_so3, skew
+from ..lie import exp_se3, exp_so3, quat_matrix, quat_mul, right_jacobian_so3, skew
 from .simulate import INTEGRATORS
 
 
@@ -42,13 +48,61 @@ def _acceleration_derivatives(model, q, v, tau):
     from ..algorithms.aba import aba
     from ..algorithms.aba_derivatives import aba_derivatives
 
-    tau = np.asarray(tau, dtype=float)
-    if tau.shape[-1:] != (model.nv,):
-        raise ValueError(f"tau: expected shape (..., {model.nv}), got {tau.shape}")
     limit = model.effort_limit
     clipped = np.clip(tau, -limit, limit)
     Aq, Av, Minv = aba_derivatives(model, q, v, clipped)
     return aba(model, q, v, clipped), Aq, Av, Minv * (np.abs(tau) <= limit)[..., None, :]
+
+
+def _inverse_jr_coefficients(t):
+    """``c(t)`` and ``c'(t) / t`` of ``Jr^-1`` (series below 1e-2, where the closed forms cancel)."""
+    small = t < 1e-2
+    ts = np.where(small, 1.0, t)
+    g = 1.0 - 0.5 * ts / np.tan(0.5 * ts)
+    dg = -0.5 / np.tan(0.5 * ts) + 0.25 * ts / np.sin(0.5 * ts) ** 2
+    c = np.where(small, 1 / 12 + t * t / 720, g / ts ** 2)
+    dc = np.where(small, 1 / 360 + t * t / 7560, dg / ts ** 3 - 2 * g / ts ** 4)
+    return c, dc
+
+
+def _chart(model, q0, theta, v):
+    """``(q, k, Dq0, Dth, Kq, Kth, Kv)``: the point ``q = q0 ⊞ theta``, the chart's rate
+    ``k(q0, theta, v)`` and their Jacobians (see the module docstring), each (..., nv, nv)."""
+    n = model.nv
+    eye = np.broadcast_to(np.eye(n), theta.shape[:-1] + (n, n))
+    Dq0, Dth, Kv = eye.copy(), eye.copy(), eye.copy()
+    Kq, Kth = np.zeros_like(Dq0), np.zeros_like(Dq0)
+    q, k = q0.copy(), v.copy()
+    one = model.joint_type != J.FREE
+    q[..., model.idx_q[one]] += theta[..., model.idx_v[one]]
+    for i in np.flatnonzero(~one):
+        iq, iv = model.idx_q[i], model.idx_v[i]
+        lin, ang = slice(iv, iv + 3), slice(iv + 3, iv + 6)
+        phi, w, vl = theta[..., ang], v[..., ang], v[..., lin]
+        quat = quat_mul(q0[..., iq + 3:iq + 7], exp_se3(np.concatenate([np.zeros_like(phi), phi], -1))[0])
+        quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
+        q[..., iq:iq + 3] = q0[..., iq:iq + 3] + theta[..., lin]
+        q[..., iq + 3:iq + 7] = quat
+        R, E, Jr = quat_matrix(quat), exp_so3(phi), right_jacobian_so3(phi)
+        Et, P, W = np.swapaxes(E, -1, -2), skew(phi), skew(w)
+        t = np.linalg.norm(phi, axis=-1)
+        c, dc = _inverse_jr_coefficients(t)
+        c, dc = c[..., None, None], dc[..., None, None]
+        Jr_inv = np.eye(3) + 0.5 * P + c * (P @ P)
+        k[..., lin] = np.einsum("...ij,...j->...i", R, vl)
+        k[..., ang] = np.einsum("...ij,...j->...i", Jr_inv, w)
+        RV = R @ skew(vl)
+        ppw = (P @ P @ w[..., None])  # phi x (phi x w), (..., 3, 1)
+        pw = np.sum(phi * w, -1)[..., None, None]
+        Dq0[..., lin, lin], Dq0[..., ang, ang] = Et, Et
+        Dth[..., lin, lin], Dth[..., ang, ang] = np.swapaxes(R, -1, -2), Jr
+        Kv[..., lin, lin], Kv[..., ang, ang] = R, Jr_inv
+        Kq[..., lin, ang] = -RV @ Et
+        Kth[..., lin, ang] = -RV @ Jr
+        Kth[..., ang, ang] = (-0.5 * W + c * (pw * np.eye(3) + phi[..., :, None] * w[..., None, :]
+                                              - 2.0 * w[..., :, None] * phi[..., None, :])
+                              + dc * ppw * phi[..., None, :])
+    return q, k, Dq0, Dth, Kq, Kth, Kv
 
 
 def linearize(model, q, v, tau, dt: float, integrator: str = "semi_implicit_euler") -> tuple[np.ndarray, np.ndarray]:
@@ -57,7 +111,7 @@ def linearize(model, q, v, tau, dt: float, integrator: str = "semi_implicit_eule
 
     Args:
         q: (..., nq). v, tau: (..., nv). dt: the step, seconds (> 0).
-        integrator: ``"semi_implicit_euler"`` or ``"rk4"`` (joints of one dof only: no free joint).
+        integrator: ``"semi_implicit_euler"`` or ``"rk4"``, as in :func:`simulate`.
 
     Returns:
         ``A`` (..., 2 nv, 2 nv) and ``B`` (..., 2 nv, nv), acting on ``[dq; dv]`` and ``du``.
@@ -69,66 +123,51 @@ def linearize(model, q, v, tau, dt: float, integrator: str = "semi_implicit_eule
         raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS}")
     if not (isinstance(dt, (int, float, np.floating, np.integer)) and np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: expected a positive number of seconds, got {dt!r}")
-    dt = float(dt)
-    free = np.flatnonzero(model.joint_type == J.FREE)
-    if integrator == "rk4":
-        if free.size:
-            raise ValueError(f"linearize: integrator 'rk4' needs joints of one dof; {model.body_joint_names[free[0]]!r} "
-                             "is a free joint (use integrator='semi_implicit_euler')")
-        return _rk4(model, q, v, tau, dt)
-    return _semi_implicit_euler(model, q, v, tau, dt, free)
+    arrays = {}
+    for name, x, size in (("q", q, model.nq), ("v", v, model.nv), ("tau", tau, model.nv)):
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 0 or x.shape[-1] != size:
+            raise ValueError(f"{name}: expected shape (..., {size}), got {x.shape}")
+        arrays[name] = x
+    try:
+        batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays.values()))
+    except ValueError:
+        raise ValueError("linearize: the batch shapes of q, v and tau do not broadcast: "
+                         + ", ".join(f"{k} {x.shape}" for k, x in arrays.items())) from None
+    q, v, tau = (np.broadcast_to(x, batch + x.shape[-1:]) for x in arrays.values())
+    stages = ((1.0, 0.0),) if integrator == "semi_implicit_euler" else ((1.0, 0.0), (2.0, 0.5), (2.0, 0.5), (1.0, 1.0))
+    return _step(model, q, v, tau, float(dt), stages, integrator == "semi_implicit_euler")
 
 
-def _assemble(Aq, Av, Bu, Gq, Gv, dt):
-    """``A``, ``B`` of ``dv+ = dt Aq dq + (1 + dt Av) dv + dt Bu du``, ``dq+ = Gq dq + Gv dv+``."""
-    n = Aq.shape[-1]
-    eye = np.eye(n)
-    Vq, Vv, Vu = dt * Aq, eye + dt * Av, dt * Bu
-    A = np.concatenate([np.concatenate([Gq + Gv @ Vq, Gv @ Vv], -1), np.concatenate([Vq, Vv], -1)], -2)
-    return A, np.concatenate([Gv @ Vu, Vu], -2)
-
-
-def _semi_implicit_euler(model, q, v, tau, dt, free):
-    a, Aq, Av, Bu = _acceleration_derivatives(model, q, v, tau)
+def _step(model, q0, v, tau, dt, stages, euler):
+    """``(A, B)`` of a step with Runge-Kutta ``stages`` ``(weight, c)`` in the chart at ``q0``
+    (the semi-implicit Euler step when ``euler``: one stage, then the chart moves with ``v+``)."""
     n = model.nv
-    v_next = np.asarray(v, dtype=float) + dt * a
-    Gq = np.broadcast_to(np.eye(n), Aq.shape).copy()
-    Gv = dt * Gq
-    for i in free:
-        k = model.idx_v[i]
-        lin, ang = slice(k, k + 3), slice(k + 3, k + 6)
-        E, Jr = exp_so3(dt * v_next[..., ang]), right_jacobian_so3(dt * v_next[..., ang])
-        Et = np.swapaxes(E, -1, -2)
-        Gq[..., lin, lin] = Et
-        Gq[..., lin, ang] = -dt * Et @ skew(v_next[..., lin])
-        Gq[..., ang, ang] = Et
-        Gv[..., lin, lin] = dt * Et
-        Gv[..., ang, ang] = dt * Jr
-    return _assemble(Aq, Av, Bu, Gq, Gv, dt)
-
-
-def _rk4(model, q, v, tau, dt):
-    q, v = np.asarray(q, dtype=float), np.asarray(v, dtype=float)
-    n = model.nv
-    eye = np.eye(n)
-    zero = np.zeros(np.broadcast_shapes(q.shape[:-1], v.shape[:-1], np.shape(tau)[:-1]) + (n, n))
-    Kx, Ku = [], []
-    dq, dv = np.zeros_like(q), np.zeros_like(v)
-    Px, Pu = None, None  # the previous stage's Jacobians
-    for c in (0.0, 0.5, 0.5, 1.0):
-        qs, vs = q + c * dt * dq, v + c * dt * dv
+    shape = q0.shape[:-1] + (n, 3 * n)
+    Iq, Iv, Iu = (np.zeros(shape) for _ in range(3))
+    for block, I in enumerate((Iq, Iv, Iu)):
+        I[..., np.arange(n), block * n + np.arange(n)] = 1.0
+    theta, dtheta = np.zeros_like(v), np.zeros(shape)
+    vs, dvs = v, Iv
+    total = sum(w for w, _ in stages)
+    k_sum, dk_sum, a_sum, da_sum = 0.0, 0.0, 0.0, 0.0
+    k, dk, a, da = None, None, None, None
+    for weight, c in stages:
+        if k is not None:
+            theta, dtheta = c * dt * k, c * dt * dk
+            vs, dvs = v + c * dt * a, Iv + c * dt * da
+        qs, _, Dq0, Dth, _, _, _ = _chart(model, q0, theta, vs)
         a, Aq, Av, Bu = _acceleration_derivatives(model, qs, vs, tau)
-        F = np.concatenate([np.concatenate([zero, zero + eye], -1), np.concatenate([Aq, Av], -1)], -2)
-        Fu = np.concatenate([zero, Bu], -2)
-        if Px is None:
-            kx, ku = F, Fu
-        else:
-            kx = F + c * dt * F @ Px
-            ku = Fu + c * dt * F @ Pu
-        Kx.append(kx)
-        Ku.append(ku)
-        Px, Pu, dq, dv = kx, ku, vs, a
-    w = (1.0, 2.0, 2.0, 1.0)
-    A = np.eye(2 * n) + dt / 6.0 * sum(wi * k for wi, k in zip(w, Kx))
-    B = dt / 6.0 * sum(wi * k for wi, k in zip(w, Ku))
-    return A, B
+        da = Aq @ (Dq0 @ Iq + Dth @ dtheta) + Av @ dvs + Bu @ Iu
+        if euler:  # the chart moves with the new velocity
+            vs, dvs = v + dt * a, Iv + dt * da
+        _, k, _, _, Kq, Kth, Kv = _chart(model, q0, theta, vs)
+        dk = Kq @ Iq + Kth @ dtheta + Kv @ dvs
+        k_sum, dk_sum = k_sum + weight * k, dk_sum + weight * dk
+        a_sum, da_sum = a_sum + weight * a, da_sum + weight * da
+    theta_next, dtheta_next = dt / total * k_sum, dt / total * dk_sum
+    _, _, Dq0, Dth, _, _, _ = _chart(model, q0, theta_next, v)
+    dq_next = Dq0 @ Iq + Dth @ dtheta_next
+    dv_next = Iv + dt / total * da_sum
+    J_ = np.concatenate([dq_next, dv_next], -2)
+    return J_[..., :2 * n], J_[..., 2 * n:]
