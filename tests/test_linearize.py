@@ -145,3 +145,15 @@ def test_ilqr_example_swings_the_double_pendulum_up():
                        lambda t, q, v: U[min(int(round(t / ex.DT)), ex.HORIZON - 1)], "semi_implicit_euler",
                        progress=False)
     assert_rel(np.hstack([traj.q, traj.v]), X, 1e-9)
+
+
+def test_lqr_panda_example_returns_to_the_pose_after_a_push():
+    import lqr_panda as ex
+
+    model = rd.models.load("panda")
+    _, eigenvalues = ex.lqr_gain(model, ex.POSE)
+    assert np.abs(eigenvalues).max() < 1.0
+    traj = ex.run()
+    err = np.abs(traj.q - ex.POSE).max(axis=1)
+    assert err.max() > 0.01 and err[-1] < 1e-6 and np.abs(traj.v[-1]).max() < 1e-6
+    assert np.all(np.abs(traj.tau) <= model.effort_limit)
