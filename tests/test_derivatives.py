@@ -174,3 +174,39 @@ def test_aba_derivatives_of_a_singular_model(floating_base):
                                          r"joint 'knuckle'\) is singular"):
         rd.aba_derivatives(model, q, z, z)
     rd.rnea_derivatives(model, q, z, z)  # inverse dynamics is defined
+
+
+@random_models
+def test_derivatives_of_the_terms_are_their_differences(model):
+    m = with_friction_and_armature(model, rng_for(model.name, "terms"), 0.2)  # the terms leave friction out
+    q, v, _ = states(model, "terms")
+    dg = rd.gravity_derivatives(m, q)
+    assert_rel(dg, richardson(lambda d: rd.gravity(m, rd.integrate(m, q, d)), m.nv), FD_TOL, "dg/dq")
+    nq, nv = rd.nonlinear_effects_derivatives(m, q, v)
+    fd_q, fd_v = by_differences(lambda m_, q_, v_, _: rd.nonlinear_effects(m_, q_, v_), m, q, v, None)
+    assert_rel(nq, fd_q, FD_TOL, "d nle/dq")
+    assert_rel(nv, fd_v, FD_TOL, "d nle/dv")
+    for armature in (True, False):
+        pq, M = rd.generalized_momentum_derivatives(m, q, v, armature=armature)
+        fd_q, fd_v = by_differences(lambda m_, q_, v_, _: rd.generalized_momentum(m_, q_, v_, armature=armature),
+                                    m, q, v, None)
+        assert_rel(pq, fd_q, FD_TOL, "d(M v)/dq")
+        assert_rel(M, fd_v, FD_TOL, "d(M v)/dv")
+        assert_rel(M, rd.crba(m, q, armature=armature), 1e-12)
+
+
+def test_derivatives_of_the_terms_batch_and_bad_input():
+    model = random_model(5, seed=34, floating_base=True)
+    Q, V, _ = states(model, "terms-batch", size=(2, 3))
+    for fun, args in ((rd.gravity_derivatives, (Q,)), (rd.nonlinear_effects_derivatives, (Q, V)),
+                      (rd.generalized_momentum_derivatives, (Q, V))):
+        out = fun(model, *args)
+        for i in np.ndindex(2, 3):
+            one = fun(model, *(x[i] for x in args))
+            for x, y in zip(out if isinstance(out, tuple) else (out,), one if isinstance(one, tuple) else (one,)):
+                assert x.shape == (2, 3, model.nv, model.nv)
+                assert_rel(x[i], y, 1e-12)
+        with pytest.raises(ValueError, match=r"q contains NaN or Inf"):
+            fun(model, np.full(model.nq, np.nan), *args[1:])
+        with pytest.raises(ValueError, match=rf"q: expected shape \(\.\.\., {model.nq}\)"):
+            fun(model, np.zeros(model.nq + 1), *args[1:])

@@ -2,7 +2,7 @@
 
 For each robot Pinocchio loads, three random states: forward kinematics, rnea (with and
 without external wrenches), aba, crba, the derivatives of rnea and aba (with and without
-external wrenches), gravity, nonlinear effects, the Coriolis matrix, the
+external wrenches) and of gravity, gravity, nonlinear effects, the Coriolis matrix, the
 Jacobians of the last body in the three frames, the centre of mass and both energies, each to
 a relative error (max abs difference / max(1, max abs of Pinocchio's value)) below 1e-9.
 
@@ -126,6 +126,8 @@ def _compare(pair: Pair, q, v, a, f_ext, singular):
         dq, dv, da = pin.computeRNEADerivatives(pm, data, qp, v, a, *wrenches)
         for what, x, y in (("dtau_dq", mine[0], dq), ("dtau_dv", mine[1], dv), ("dtau_da", mine[2], _symmetric(da))):
             check(what + name, x, y)
+    check("gravity_derivatives", rd.gravity_derivatives(model, q),
+          pin.computeGeneralizedGravityDerivatives(pm, data, qp))
     tau = rd.rnea(model, q, v, a, friction=False)
     if singular is None:
         check("aba", rd.aba(model, q, v, tau, friction=False), pin.aba(pm, data, qp, v, tau))

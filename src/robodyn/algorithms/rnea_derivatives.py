@@ -396,14 +396,16 @@ def rnea_derivatives(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, 
             return out
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
-    return run(model, batch, x, F, fcode, check_finite, friction, armature, "rnea_derivatives")
+    return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)
 
 
-def run(model, batch, x, F, fcode, check, friction, armature, what, mass=True):
-    """:func:`rnea_derivatives` on checked inputs ``x = {"q", "v", "a"}``; ``mass=False``
-    leaves ``dtau_da`` out (and returns an empty array in its place)."""
+def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea_derivatives",
+        report=None, mass=True):
+    """:func:`rnea_derivatives` on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``),
+    gravity, friction and armature switched as given; errors name the arrays of ``report``
+    (default ``x``). ``mass=False`` leaves ``dtau_da`` out (an empty array in its place)."""
     k, nv = model.kernel, model.nv
-    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[bool(gravity)]
     (dq, rq), (dv, rv) = (_inputs.output(None, batch, (nv, nv), x) for _ in range(2))
     M, rM = _inputs.output(None, batch, (nv, nv) if mass else (0, 0), x)
     if batch == ():
@@ -412,5 +414,5 @@ def run(model, batch, x, F, fcode, check, friction, armature, what, mass=True):
         status = np.empty(x["q"].shape[0], dtype=np.int64)
         _derivatives_batch((k.ints, k.body, dofs, params, x["q"], x["v"], x["a"], F, fcode, check, dq, dv, M),
                            (model.nbodies, nv), status, chunks(status.shape[0]))
-    raise_for_status(model, status, x, what)
+    raise_for_status(model, status, x if report is None else report, what)
     return rq, rv, rM

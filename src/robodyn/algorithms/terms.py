@@ -1,10 +1,12 @@
-"""Terms of the equation of motion ``M(q) qdd + C(q, v) v + g(q) = tau``, from the RNEA.
+"""Terms of the equation of motion ``M(q) qdd + C(q, v) v + g(q) = tau``, from the RNEA, and
+their derivatives, from the RNEA's (``rnea_derivatives.py``).
 
     gravity(q)                 = rnea(q, 0, 0)          = g(q)
     nonlinear_effects(q, v)    = rnea(q, v, 0)          = C(q, v) v + g(q)
     generalized_momentum(q, v) = rnea(q, 0, v) - g(q)   = M(q) v   (gravity switched off)
 
 All without friction (these are the rigid-body terms; :func:`robodyn.rnea` adds friction).
+Derivatives with respect to ``q`` are in the tangent space of :func:`robodyn.integrate`.
 """
 
 from __future__ import annotations
@@ -12,18 +14,19 @@ from __future__ import annotations
 import numpy as np
 
 from . import _inputs
-from .rnea import run
+from . import rnea, rnea_derivatives
 
 
-def _rnea_term(model, what, check_finite, gravity, armature, given, roles) -> np.ndarray:
-    """``rnea`` without friction on the caller's arrays ``given`` (by their names), with
-    ``roles`` mapping the kernel's ``v``/``a`` to a given name (missing: zeros)."""
+def _rnea_term(model, what, check_finite, gravity, armature, given, roles, run=rnea.run, **options):
+    """``run`` (the RNEA, or its derivatives) without friction on the caller's arrays ``given``
+    (by their names), with ``roles`` mapping the kernel's ``v``/``a`` to a given name (missing:
+    zeros)."""
     batch, x = _inputs.states(model, **given)
     zeros = np.zeros(model.nv) if batch == () else np.zeros((x["q"].shape[0], model.nv))
     kin = {"q": x["q"], **{role: x[name] if name else zeros for role, name in roles.items()}}
     F, fcode = _inputs.body_wrenches(model, None, batch, "local")
     return run(model, batch, kin, F, fcode, check_finite, gravity=gravity, friction=False, armature=armature,
-               what=what, report=x)
+               what=what, report=x, **options)
 
 
 def gravity(model, q, *, check_finite: bool = True) -> np.ndarray:
@@ -40,3 +43,26 @@ def generalized_momentum(model, q, v, *, armature: bool = True, check_finite: bo
     """Generalised momentum ``M(q) v`` (..., nv), O(n) (``armature`` as in :func:`robodyn.crba`)."""
     return _rnea_term(model, "generalized_momentum", check_finite, False, armature, {"q": q, "v": v},
                       {"v": None, "a": "v"})
+
+
+def gravity_derivatives(model, q, *, check_finite: bool = True) -> np.ndarray:
+    """``dg/dq`` (..., nv, nv) of :func:`robodyn.gravity` (Pinocchio's
+    ``computeGeneralizedGravityDerivatives``)."""
+    return _rnea_term(model, "gravity_derivatives", check_finite, True, False, {"q": q}, {"v": None, "a": None},
+                      rnea_derivatives.run, mass=False)[0]
+
+
+def nonlinear_effects_derivatives(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """``(d/dq, d/dv)`` (..., nv, nv) of ``C(q, v) v + g(q)`` (:func:`robodyn.nonlinear_effects`)."""
+    return _rnea_term(model, "nonlinear_effects_derivatives", check_finite, True, False, {"q": q, "v": v},
+                      {"v": "v", "a": None}, rnea_derivatives.run, mass=False)[:2]
+
+
+def generalized_momentum_derivatives(model, q, v, *, armature: bool = True,
+                                     check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """``(d(M v)/dq, M)`` (..., nv, nv) of :func:`robodyn.generalized_momentum` (``d(M v)/dv =
+    M``, with the armature when ``armature``)."""
+    dq, _, M = _rnea_term(model, "generalized_momentum_derivatives", check_finite, False, armature,
+                          {"q": q, "v": v}, {"v": None, "a": "v"}, rnea_derivatives.run)
+    return dq, M
+
