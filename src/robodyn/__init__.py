@@ -20,7 +20,8 @@ _LAZY = {
     "jacobian": "jacobian", "jacobian_dot_times_v": "jacobian", "forward_kinematics": "kinematics",
     "frame_pose": "kinematics", "rnea": "rnea", "generalized_momentum": "terms", "gravity": "terms",
     "nonlinear_effects": "terms", "gravity_derivatives": "terms", "nonlinear_effects_derivatives": "terms",
-    "generalized_momentum_derivatives": "terms", "integrate": "integrate", "difference": "integrate",
+    "generalized_momentum_derivatives": "terms", "frame_velocity_derivatives": "frame_derivatives",
+    "frame_acceleration_derivatives": "frame_derivatives", "integrate": "integrate", "difference": "integrate",
     "integrate_jacobians": "integrate", "difference_jacobians": "integrate",
     "hybrid_dynamics": "hybrid", "inverse_mass_matrix": "minv", "constrained_dynamics": "constrained",
     "ConstrainedDynamics": "constrained", "PointConstraint": "constrained", "WeldConstraint": "constrained",
@@ -75,7 +76,7 @@ __all__ = [
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
     "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
-    "generalized_momentum_derivatives",
+    "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

@@ -33,6 +33,8 @@ def _algorithm_steps(rd, model, q, v, a):
         ("com_jacobian", lambda: rd.com_jacobian(model, q)),
         ("jacobian", lambda: rd.jacobian(model, q, last)),
         ("jacobian_dot_times_v", lambda: rd.jacobian_dot_times_v(model, q, v, last)),
+        ("frame_velocity_derivatives", lambda: rd.frame_velocity_derivatives(model, q, v, last)),
+        ("frame_acceleration_derivatives", lambda: rd.frame_acceleration_derivatives(model, q, v, a, last)),
         ("forward_kinematics", lambda: rd.forward_kinematics(model, q)),
         ("frame_pose", lambda: rd.frame_pose(model, q, model.link_names[last])),
         ("integrate", lambda: rd.integrate(model, q, v)),
@@ -84,13 +86,14 @@ def _public():
     from types import SimpleNamespace
 
     from . import random
-    from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, hybrid, integrate,
-                             jacobian, kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms)
+    from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives,
+                             hybrid, integrate, jacobian, kinematics, minv, regressor, rnea, rnea_derivatives,
+                             task_space, terms)
     from .simulation import simulate
 
     names = {}
-    for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, hybrid, integrate, jacobian,
-                   kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms):
+    for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives, hybrid,
+                   integrate, jacobian, kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module) if not n.startswith("_")})
     return SimpleNamespace(**names, simulate=simulate, random=random)
 
