@@ -83,7 +83,7 @@ def _simulation_steps(rd, model):
 
 def _public():
     """The public functions and classes used here, by their names in ``robodyn``."""
-    from types import SimpleNamespace
+    from types import ModuleType, SimpleNamespace
 
     from . import random
     from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives,
@@ -94,7 +94,8 @@ def _public():
     names = {}
     for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives, hybrid,
                    integrate, jacobian, kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms):
-        names.update({n: getattr(module, n) for n in dir(module) if not n.startswith("_")})
+        names.update({n: getattr(module, n) for n in dir(module)
+                      if not n.startswith("_") and not isinstance(getattr(module, n), ModuleType)})
     return SimpleNamespace(**names, simulate=simulate, random=random)
 
 

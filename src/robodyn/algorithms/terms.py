@@ -14,10 +14,11 @@ from __future__ import annotations
 import numpy as np
 
 from . import _inputs
-from . import rnea, rnea_derivatives
+from .rnea import run as _rnea_run
+from .rnea_derivatives import run as _derivatives_run
 
 
-def _rnea_term(model, what, check_finite, gravity, armature, given, roles, run=rnea.run, **options):
+def _rnea_term(model, what, check_finite, gravity, armature, given, roles, run=_rnea_run, **options):
     """``run`` (the RNEA, or its derivatives) without friction on the caller's arrays ``given``
     (by their names), with ``roles`` mapping the kernel's ``v``/``a`` to a given name (missing:
     zeros)."""
@@ -49,13 +50,13 @@ def gravity_derivatives(model, q, *, check_finite: bool = True) -> np.ndarray:
     """``dg/dq`` (..., nv, nv) of :func:`robodyn.gravity` (Pinocchio's
     ``computeGeneralizedGravityDerivatives``)."""
     return _rnea_term(model, "gravity_derivatives", check_finite, True, False, {"q": q}, {"v": None, "a": None},
-                      rnea_derivatives.run, mass=False)[0]
+                      _derivatives_run, mass=False)[0]
 
 
 def nonlinear_effects_derivatives(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """``(d/dq, d/dv)`` (..., nv, nv) of ``C(q, v) v + g(q)`` (:func:`robodyn.nonlinear_effects`)."""
     return _rnea_term(model, "nonlinear_effects_derivatives", check_finite, True, False, {"q": q, "v": v},
-                      {"v": "v", "a": None}, rnea_derivatives.run, mass=False)[:2]
+                      {"v": "v", "a": None}, _derivatives_run, mass=False)[:2]
 
 
 def generalized_momentum_derivatives(model, q, v, *, armature: bool = True,
@@ -63,6 +64,6 @@ def generalized_momentum_derivatives(model, q, v, *, armature: bool = True,
     """``(d(M v)/dq, M)`` (..., nv, nv) of :func:`robodyn.generalized_momentum` (``d(M v)/dv =
     M``, with the armature when ``armature``)."""
     dq, _, M = _rnea_term(model, "generalized_momentum_derivatives", check_finite, False, armature,
-                          {"q": q, "v": v}, {"v": None, "a": "v"}, rnea_derivatives.run)
+                          {"q": q, "v": v}, {"v": None, "a": "v"}, _derivatives_run)
     return dq, M
 
