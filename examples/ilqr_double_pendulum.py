@@ -5,8 +5,9 @@
 The double pendulum of ``rd.models`` (two 1 kg point masses on 1 m links, a motor on each
 joint, ``q = 0`` upright) starts hanging at rest, ``q = (pi, 0)``, and must reach the upright
 equilibrium in ``T = 3 s``. The discrete dynamics are the semi-implicit Euler step of
-``rd.simulate`` (``v+ = v + dt aba(q, v, u)``, ``q+ = q + dt v+``), linearised along the whole
-trajectory at once by ``rd.linearize`` (one batched call per iteration). The cost is
+``rd.simulate`` (``v+ = v + dt aba(q, v, u)``, ``q+ = q + dt v+``; the double pendulum's
+effort limits are infinite, so nothing is clipped), linearised along the whole trajectory at
+once by ``rd.linearize`` (one batched call per iteration). The cost is
 quadratic: ``sum_k (x_k - x*)^T Q (x_k - x*) + u_k^T R u_k`` plus a terminal weight ``Qf``.
 Each iteration solves the Riccati recursion backwards (with Levenberg-Marquardt
 regularisation of ``Quu``) and rolls the new policy out with a backtracking line search.
@@ -55,7 +56,8 @@ def ilqr(model, x0, target, iterations: int = 100, tol: float = 1e-6):
     X, U = rollout(model, x0, U)
     costs, mu = [cost(X, U, target)], 1e-6
     for _ in range(iterations):
-        A, B = rd.linearize(model, X[:-1, :model.nv], X[:-1, model.nv:], U, DT)  # (N, 4, 4), (N, 4, 2)
+        A, B = rd.linearize(model, X[:-1, :model.nv], X[:-1, model.nv:], U, DT,  # (N, 4, 4), (N, 4, 2)
+                            "semi_implicit_euler")
         Vx, Vxx = QF @ (X[-1] - target), QF.copy()
         K, kff = np.zeros((HORIZON, model.nv, 2 * model.nv)), np.zeros((HORIZON, model.nv))
         for k in range(HORIZON - 1, -1, -1):

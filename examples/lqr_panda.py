@@ -7,7 +7,8 @@ discrete LQR gain ``K`` designed on ``rd.linearize`` (one RK4 step of ``dt``):
 ``tau = tau* - K [q ⊖ q*; v]`` (clipped at the joints' effort limits by the simulator). A
 push of impulse ``p`` (N s, world axes) at the origin of the last link changes the velocity
 by ``dv = M^-1 J^T [p; 0]`` (the impulsive form of ``M dv/dt = J^T f``); ``rd.simulate`` runs
-the arm from there back to ``q*``. Reference: Featherstone, RBDA (2008), section 11.1
+the arm from there back to ``q*``, the controller evaluated at every stage of its RK4 steps
+(close to the torque held over a step that the design assumes). Reference: Featherstone, RBDA (2008), section 11.1
 (impulsive dynamics); Anderson and Moore, *Optimal Control* (1990), ch. 2 (discrete LQR).
 """
 

@@ -11,8 +11,7 @@ import pinocchio as pin
 import pytest
 
 import robodyn as rd
-from helpers import assert_rel, random_models, rng_for, states
-from test_derivatives import FD_TOL, richardson
+from helpers import FD_TOL, assert_rel, random_models, richardson, states
 from urdf_subset import load_pair, pairs
 
 FRAMES = ("world", "local", "local_world_aligned")

@@ -1,6 +1,6 @@
 """robodyn.linearize: the (A, B) of one simulate step against differences of simulate itself
-(both integrators, fixed and floating bases, friction and armature, clipped joints), batches,
-bad input, and the LQR example (examples/lqr_acrobot.py) it serves."""
+(both integrators, fixed and floating bases, viscous and smoothed Coulomb friction, armature,
+clipped and unactuated joints), batches, bad input, and the LQR and iLQR examples it serves."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import assert_rel, rng_for
+from helpers import assert_rel, richardson, rng_for
 from robodyn.random import random_model, random_state
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
@@ -30,21 +30,15 @@ def one_step(model, q, v, tau, integrator):
 
 
 def by_differences(model, q, v, tau, integrator):
+    """``(A, B)`` by differences of :func:`one_step` in tangent coordinates."""
     q1, v1 = one_step(model, q, v, tau, integrator)
     n = model.nv
 
-    def moved(k, d):
-        e = np.zeros(n)
-        e[k % n] = d
-        x = (rd.integrate(model, q, e), v, tau) if k < n else (q, v + e, tau) if k < 2 * n else (q, v, tau + e)
-        qp, vp = one_step(model, *x, integrator)
+    def moved(d):
+        qp, vp = one_step(model, rd.integrate(model, q, d[:n]), v + d[n:2 * n], tau + d[2 * n:], integrator)
         return np.concatenate([rd.difference(model, q1, qp), vp - v1])
 
-    cols = []
-    for k in range(3 * n):
-        d = [(moved(k, h) - moved(k, -h)) / (2 * h) for h in (STEP, STEP / 2)]
-        cols.append((4 * d[1] - d[0]) / 3)
-    J = np.stack(cols, -1)
+    J = richardson(moved, 3 * n, STEP)
     return J[:, :2 * n], J[:, 2 * n:]
 
 
@@ -56,7 +50,8 @@ CASES = [(4, 1, False, "semi_implicit_euler"), (4, 1, False, "rk4"), (5, 2, True
 def test_against_differences_of_simulate(n, seed, floating_base, integrator):
     rng = rng_for("linearize", n, seed, floating_base, integrator)
     base = random_model(n, seed=seed, floating_base=floating_base, branching=0.5)
-    model = base.replace(damping=rng.uniform(0.1, 1.0, base.nv), armature=rng.uniform(0.01, 0.1, base.nv))
+    model = base.replace(damping=rng.uniform(0.1, 1.0, base.nv), armature=rng.uniform(0.01, 0.1, base.nv),
+                         coulomb=rng.uniform(0.1, 1.0, base.nv), coulomb_smoothing=0.5)
     q, v, tau = random_state(model, rng)
     A, B = rd.linearize(model, q, v, tau, DT, integrator)
     fd_A, fd_B = by_differences(model, q, v, tau, integrator)
@@ -80,15 +75,20 @@ def test_fast_spinning_base(integrator):
     assert_rel(B, fd_B, TOL, "B")
 
 
-def test_clipped_joints_have_no_input():
-    model = random_model(3, seed=4)
-    q, v, tau = random_state(model, rng_for("clip"))
-    limited = model.replace(effort_limit=np.abs(tau) * np.array([2.0, 0.5, 2.0]))  # joint 1 saturates
-    A, B = rd.linearize(limited, q, v, tau, DT)
-    fd_A, fd_B = by_differences(limited, q, v, tau, "semi_implicit_euler")
+@pytest.mark.parametrize("floating_base", [False, True])
+@pytest.mark.parametrize("integrator", ["semi_implicit_euler", "rk4"])
+def test_clipped_and_unactuated_joints_have_no_input(floating_base, integrator):
+    model = random_model(3, seed=4, floating_base=floating_base)
+    q, v, tau = random_state(model, rng_for("clip", floating_base, integrator))
+    limit = np.abs(tau) * 2.0
+    limit[-2] = np.abs(tau[-2]) / 2.0  # saturated
+    limit[-1], tau[-1] = 0.0, 0.0  # unactuated: no force whatever the command
+    limited = model.replace(effort_limit=limit)
+    A, B = rd.linearize(limited, q, v, tau, DT, integrator)
+    fd_A, fd_B = by_differences(limited, q, v, tau, integrator)
     assert_rel(A, fd_A, TOL, "A")
     assert_rel(B, fd_B, TOL, "B")
-    assert np.all(B[:, 1] == 0) and np.all(B[:, [0, 2]] != 0)
+    assert np.all(B[:, -2:] == 0) and np.all(np.any(B[:, :-2] != 0, axis=0))
 
 
 def test_batch():
@@ -107,15 +107,23 @@ def test_bad_input():
     q, v, tau = random_state(model, rng_for("bad"))
     with pytest.raises(ValueError, match="integrator: unknown 'euler'"):
         rd.linearize(model, q, v, tau, DT, "euler")
-    for dt in (0.0, -1.0, np.nan, "0.1"):
+    for dt in (0.0, -1.0, np.nan, "0.1", True):
         with pytest.raises(ValueError, match="dt: expected a positive number"):
             rd.linearize(model, q, v, tau, dt)
+    with pytest.raises(ValueError, match="v: expected an array of numbers, got str"):
+        rd.linearize(model, q, "abc", tau, DT)
+    bad = q.copy()
+    bad[3:7] *= 2.0
+    with pytest.raises(ValueError, match=r"linearize: q: quaternion q\[3:7\] has norm 2, not 1"):
+        rd.linearize(model, bad, v, tau, DT)
     with pytest.raises(ValueError, match=r"q: expected shape \(\.\.\., 10\), got \(9,\)"):
         rd.linearize(model, q[:-1], v, tau, DT)
     with pytest.raises(ValueError, match="do not broadcast"):
         rd.linearize(model, np.stack([q] * 2), np.stack([v] * 3), tau, DT)
-    with pytest.raises(ValueError, match=r"\bv\b.*NaN"):
+    with pytest.raises(ValueError, match=r"linearize: v contains NaN or Inf \(first at index \(0,\)\)"):
         rd.linearize(model, q, np.full(model.nv, np.nan), tau, DT)
+    with pytest.raises(ValueError, match=r"linearize: tau contains NaN or Inf"):
+        rd.linearize(model, q, v, np.full(model.nv, np.inf), DT)
     with pytest.raises(ValueError, match=r"\btau\b"):
         rd.linearize(model, q, v, tau[:-1], DT)
 
@@ -123,13 +131,14 @@ def test_bad_input():
 def test_lqr_acrobot_example_keeps_the_acrobot_upright():
     import lqr_acrobot
 
-    model = rd.models.load("double_pendulum")
+    model = lqr_acrobot.acrobot()
+    _, B = rd.linearize(model, np.zeros(2), np.zeros(2), np.zeros(2), lqr_acrobot.DT)
+    assert np.all(B[:, 0] == 0) and np.all(B[2:, 1] != 0)  # no shoulder motor: effort limit 0
     _, eigenvalues = lqr_acrobot.lqr_gain(model)
     assert np.abs(eigenvalues).max() < 1.0
     traj = lqr_acrobot.run()
     assert np.abs(traj.q).max() > 0.1  # the push moved it
     assert np.abs(traj.q[-1]).max() < 1e-6 and np.abs(traj.v[-1]).max() < 1e-6
-    assert np.all(traj.tau[:, 0] == 0)  # the shoulder has no motor
 
 
 def test_ilqr_example_swings_the_double_pendulum_up():
@@ -156,4 +165,4 @@ def test_lqr_panda_example_returns_to_the_pose_after_a_push():
     traj = ex.run()
     err = np.abs(traj.q - ex.POSE).max(axis=1)
     assert err.max() > 0.01 and err[-1] < 1e-6 and np.abs(traj.v[-1]).max() < 1e-6
-    assert np.all(np.abs(traj.tau) <= model.effort_limit)
+    assert np.all(np.abs(traj.tau).max(axis=0) < 0.9 * model.effort_limit)  # never near clipping

@@ -1,5 +1,6 @@
 """Terms of the equation of motion (robodyn.gravity, nonlinear_effects, generalized_momentum):
-against rnea and crba, the two-link planar arm's gravity vector, batches and bad input."""
+against rnea and crba, the two-link planar arm's gravity vector, batches and bad input; their
+derivatives (gravity_derivatives, ...) against Richardson differences, batches and bad input."""
 
 from __future__ import annotations
 
@@ -7,8 +8,8 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, planar_2r,
-                     planar_2r_terms, random_model, random_models, rng_for, states,
+from helpers import (FD_TOL, PLANAR_2R, assert_rel, check_batch, check_input_validation, input_checks, planar_2r,
+                     planar_2r_terms, random_model, random_models, richardson, rng_for, states, tangent_differences,
                      with_friction_and_armature)
 
 
@@ -71,3 +72,39 @@ def test_batch(fn, names):
 @input_checks
 def test_bad_input(fn, names, aspect):
     check_input_validation(fn, names, aspect)
+
+
+@random_models
+def test_derivatives_of_the_terms_are_their_differences(model):
+    m = with_friction_and_armature(model, rng_for(model.name, "terms"), 0.2)  # the terms leave friction out
+    q, v, _ = states(model, "terms")
+    dg = rd.gravity_derivatives(m, q)
+    assert_rel(dg, richardson(lambda d: rd.gravity(m, rd.integrate(m, q, d)), m.nv), FD_TOL, "dg/dq")
+    nq, nv = rd.nonlinear_effects_derivatives(m, q, v)
+    fd_q, fd_v = tangent_differences(lambda m_, q_, v_, _: rd.nonlinear_effects(m_, q_, v_), m, q, v, None)
+    assert_rel(nq, fd_q, FD_TOL, "d nle/dq")
+    assert_rel(nv, fd_v, FD_TOL, "d nle/dv")
+    for armature in (True, False):
+        pq, M = rd.generalized_momentum_derivatives(m, q, v, armature=armature)
+        fd_q, fd_v = tangent_differences(
+            lambda m_, q_, v_, _: rd.generalized_momentum(m_, q_, v_, armature=armature), m, q, v, None)
+        assert_rel(pq, fd_q, FD_TOL, "d(M v)/dq")
+        assert_rel(M, fd_v, FD_TOL, "d(M v)/dv")
+        assert_rel(M, rd.crba(m, q, armature=armature), 1e-12)
+
+
+def test_derivatives_of_the_terms_batch_and_bad_input():
+    model = random_model(5, seed=34, floating_base=True)
+    Q, V, _ = states(model, "terms-batch", size=(2, 3))
+    for fun, args in ((rd.gravity_derivatives, (Q,)), (rd.nonlinear_effects_derivatives, (Q, V)),
+                      (rd.generalized_momentum_derivatives, (Q, V))):
+        out = fun(model, *args)
+        for i in np.ndindex(2, 3):
+            one = fun(model, *(x[i] for x in args))
+            for x, y in zip(out if isinstance(out, tuple) else (out,), one if isinstance(one, tuple) else (one,)):
+                assert x.shape == (2, 3, model.nv, model.nv)
+                assert_rel(x[i], y, 1e-12)
+        with pytest.raises(ValueError, match=r"q contains NaN or Inf"):
+            fun(model, np.full(model.nq, np.nan), *args[1:])
+        with pytest.raises(ValueError, match=rf"q: expected shape \(\.\.\., {model.nq}\)"):
+            fun(model, np.zeros(model.nq + 1), *args[1:])

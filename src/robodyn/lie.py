@@ -62,6 +62,19 @@ def exp_se3(xi: np.ndarray):
     return quat, p
 
 
+def inverse_jacobian_coefficients(t):
+    """``c(t) = (1 - (t / 2) cot(t / 2)) / t^2`` and ``c'(t) / t`` (series below 1e-2, where the
+    closed forms cancel): ``Jr(w)^-1 = 1 + [w]x / 2 + c [w]x^2`` (and ``Jl^-1``, ``V^-1`` with
+    ``-[w]x / 2``), ``t = |w|``."""
+    small = t < 1e-2
+    ts = np.where(small, 1.0, t)
+    g = 1.0 - 0.5 * ts / np.tan(0.5 * ts)
+    dg = -0.5 / np.tan(0.5 * ts) + 0.25 * ts / np.sin(0.5 * ts) ** 2
+    c = np.where(small, 1 / 12 + t * t / 720, g / ts ** 2)
+    dc = np.where(small, 1 / 360 + t * t / 7560, dg / ts ** 3 - 2 * g / ts ** 4)
+    return c, dc
+
+
 def log_se3(quat: np.ndarray, p: np.ndarray) -> np.ndarray:
     """``[v_lin, omega]`` (..., 6) with ``exp_se3`` giving the pose ``(quat, p)``, ``|omega| <= pi``."""
     quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
@@ -70,9 +83,8 @@ def log_se3(quat: np.ndarray, p: np.ndarray) -> np.ndarray:
     t = 2.0 * np.arctan2(s, quat[..., 3])
     small = t < _SMALL
     w = quat[..., :3] * np.where(small, 2.0 + t * t / 12.0, t / np.where(small, 1.0, s))[..., None]
-    # V(w)^-1 = I - [w]x / 2 + c [w]x^2, c = (1 - t sin t / (2 (1 - cos t))) / t^2
-    ts = np.where(small, 1.0, t)
-    c = np.where(small, 1.0 / 12.0 + t * t / 720.0, (1.0 - ts * np.sin(ts) / (2.0 * (1.0 - np.cos(ts)))) / ts ** 2)
+    # V(w)^-1 = I - [w]x / 2 + c [w]x^2
+    c, _ = inverse_jacobian_coefficients(t)
     wp = np.cross(w, p)
     v = p - 0.5 * wp + c[..., None] * np.cross(w, wp)
     return np.concatenate([v, w], -1)

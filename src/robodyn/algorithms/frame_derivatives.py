@@ -67,7 +67,7 @@ def _path_motions(model, J, v, a, b):
 
 def _world(model, x, b, what, check):
     """World ``(J, V, A, dV/dq, dA/dq, dA/dv, oR_b, op_b)`` of body ``b`` for the states ``x``
-    (flat batch; derivatives (B, 6, nv))."""
+    (flat batch; the Jacobian and the derivatives as columns, (B, nv, 6))."""
     JJ, OR, OP, ACC, _ = jacobian_pass(model, x, b, check, what)
     q = _inputs.as_batch(x["q"])
     v = np.broadcast_to(_inputs.as_batch(x["v"]), (q.shape[0], model.nv))
@@ -95,11 +95,9 @@ def _to_frame(frame, Rf, pf, M):
 
 def _velocity_aligned(pf, Jc, V, dV):
     """``(dv_p/dq, dv_p/dv)`` (B, nv, 6) of the frame origin's velocity in world axes."""
-    w = V[:, None, 3:]
-    dp = Jc[..., :3] + np.cross(Jc[..., 3:], pf[:, None])
-    lin_q = dV[..., :3] + np.cross(dV[..., 3:], pf[:, None]) + np.cross(w, dp)
-    lin_v = Jc[..., :3] + np.cross(Jc[..., 3:], pf[:, None])
-    return (np.concatenate([lin_q, dV[..., 3:]], -1), np.concatenate([lin_v, Jc[..., 3:]], -1), dp)
+    dp = Jc[..., :3] + np.cross(Jc[..., 3:], pf[:, None])  # the origin's velocity per dof: also dv_p/dv
+    lin_q = dV[..., :3] + np.cross(dV[..., 3:], pf[:, None]) + np.cross(V[:, None, 3:], dp)
+    return np.concatenate([lin_q, dV[..., 3:]], -1), np.concatenate([dp, Jc[..., 3:]], -1), dp
 
 
 def _finish(out, batch):
@@ -108,7 +106,7 @@ def _finish(out, batch):
     return tuple(m[0] if batch == () else m.reshape(batch + m.shape[1:]) for m in out)
 
 
-def _setup(model, body, frame, what, **arrays):
+def _setup(model, body, frame, **arrays):
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
     b, Rbf, pbf = moving_frame(model, body)
@@ -121,7 +119,7 @@ def frame_velocity_derivatives(model, q, v, body, frame: str = "world", *,
     """``(dV/dq, dV/dv)`` (..., 6, nv) of the velocity ``V = J(q) v`` of a body or frame
     (:func:`robodyn.jacobian` with the same ``body`` and ``frame``); ``dV/dv = J``, ``q``
     in the tangent space of :func:`robodyn.integrate` (see the module docstring)."""
-    b, Rbf, pbf, batch, x = _setup(model, body, frame, "frame_velocity_derivatives", q=q, v=v)
+    b, Rbf, pbf, batch, x = _setup(model, body, frame, q=q, v=v)
     Jc, V, _, dV, _, _, OR, OP = _world(model, x, b, "frame_velocity_derivatives", check_finite)
     Rf, pf = OR @ Rbf, OP + OR @ pbf
     if frame == "local_world_aligned":
@@ -138,7 +136,7 @@ def frame_acceleration_derivatives(model, q, v, a, body, frame: str = "world", *
     of a body or frame (:func:`robodyn.jacobian` and :func:`robodyn.jacobian_dot_times_v` with
     the same ``body`` and ``frame``: spatial for ``"world"``/``"local"``, classical for
     ``"local_world_aligned"``); ``dA/da = J`` (see the module docstring)."""
-    b, Rbf, pbf, batch, x = _setup(model, body, frame, "frame_acceleration_derivatives", q=q, v=v, a=a)
+    b, Rbf, pbf, batch, x = _setup(model, body, frame, q=q, v=v, a=a)
     Jc, V, A, dV, dAq, dAv, OR, OP = _world(model, x, b, "frame_acceleration_derivatives", check_finite)
     Rf, pf = OR @ Rbf, OP + OR @ pbf
     if frame == "local_world_aligned":

@@ -24,6 +24,7 @@ from ..lie import exp_se3, inverse_adjoint, log_se3, quat_matrix, quat_mul, righ
 from . import _inputs
 from .status import require_finite_result
 
+
 def _free_blocks(model):
     for i in np.flatnonzero(model.joint_type == J.FREE):
         yield int(model.idx_q[i]), int(model.idx_v[i])
@@ -50,7 +51,7 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
-    _check(model, check_finite, "integrate", q=q, v=v)
+    check_configurations(model, check_finite, "integrate", q=q, v=v)
     out = q.copy()
     iq, iv = _scalar_indices(model)
     out[..., iq] += v[..., iv]
@@ -72,12 +73,17 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
     in the frame of ``q0``'s base, rotation part of norm at most pi. Equals Pinocchio's
     ``difference(model, q0, q1)``. Reference: Lynch and Park, *Modern Robotics*, sec. 3.3.3.
     """
+    return _difference(model, q0, q1, check_finite, "difference")
+
+
+def _difference(model, q0, q1, check_finite: bool, what: str) -> np.ndarray:
+    """:func:`difference`, its errors starting with ``what``."""
     q0, q1 = (_as_configuration(model, name, a) for name, a in (("q0", q0), ("q1", q1)))
     try:
         q0, q1 = np.broadcast_arrays(q0, q1)
     except ValueError:
-        raise ValueError(f"difference: shapes of q0 {q0.shape} and q1 {q1.shape} do not broadcast") from None
-    _check(model, check_finite, "difference", q0=q0, q1=q1)
+        raise ValueError(f"{what}: shapes of q0 {q0.shape} and q1 {q1.shape} do not broadcast") from None
+    check_configurations(model, check_finite, what, q0=q0, q1=q1)
     lead = q0.shape[:-1]
     d = np.zeros(lead + (model.nv,))
     iq, iv = _scalar_indices(model)
@@ -88,7 +94,7 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
         conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
         dp = np.einsum("...ji,...j->...i", quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
         d[..., kv:kv + 6] = log_se3(quat_mul(conj0, quat1), dp)
-    return require_finite_result("difference", d, check_finite, {"q0": q0, "q1": q1})
+    return require_finite_result(what, d, check_finite, {"q0": q0, "q1": q1})
 
 
 def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -97,12 +103,12 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     first order (Pinocchio's ``dIntegrate``, arguments 0 and 1).
 
     1-dof joints: identity blocks. A free joint: ``J_q = Ad(exp(v))^-1``, ``J_v = Jr(v)``, the
-    right Jacobian of SE(3) (:func:`robodyn.lie.right_jacobian_se3`). Reference: Sola, Deray and Atchuthan,
-    "A micro Lie theory for state estimation in robotics" (2018), eqs. (68)-(69).
+    right Jacobian of SE(3) (:func:`robodyn.lie.right_jacobian_se3`). Reference: Sola, Deray
+    and Atchuthan, "A micro Lie theory for state estimation in robotics" (2018), eqs. (68)-(69).
     """
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
-    _check(model, check_finite, "integrate_jacobians", q=q, v=v)
+    check_configurations(model, check_finite, "integrate_jacobians", q=q, v=v)
     Jq = np.broadcast_to(np.eye(model.nv), q.shape[:-1] + (model.nv, model.nv)).copy()
     Jv = Jq.copy()
     for _, kv in _free_blocks(model):
@@ -121,7 +127,7 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
     1-dof joints: ``-1`` and ``1``. A free joint: ``J_1 = Jr(d)^-1`` and ``J_0 = -Jr(-d)^-1``
     (the inverse left Jacobian). Reference: Sola et al. (2018), eqs. (75)-(76) and (79).
     """
-    d = difference(model, q0, q1, check_finite=check_finite)
+    d = _difference(model, q0, q1, check_finite, "difference_jacobians")
     J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
     J0 = -J1
     for _, kv in _free_blocks(model):
@@ -141,8 +147,9 @@ def _as_configuration(model, name: str, a) -> np.ndarray:
     return a
 
 
-def _check(model, check_finite: bool, what: str, **arrays) -> None:
-    """NaN/Inf and the unit norm of the free joints' quaternions."""
+def check_configurations(model, check_finite: bool, what: str, **arrays) -> None:
+    """NaN/Inf in any of ``arrays`` (by name, when ``check_finite``) and the unit norm of the
+    free joints' quaternions in those of the configuration's size; errors start with ``what``."""
     if check_finite:
         for name, a in arrays.items():
             if not np.all(np.isfinite(a)):
@@ -154,5 +161,5 @@ def _check(model, check_finite: bool, what: str, **arrays) -> None:
         for kq, _ in _free_blocks(model):
             n = np.linalg.norm(a[..., kq + 3:kq + 7], axis=-1)
             if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
-                raise ValueError(f"{what}: {name}: quaternion q[{kq + 3}:{kq + 7}] has norm "
+                raise ValueError(f"{what}: {name}: quaternion {name}[{kq + 3}:{kq + 7}] has norm "
                                  f"{float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))]):.6g}, not 1; normalise it")

@@ -17,14 +17,18 @@ Pass 1, from the root (``ov``, ``oa``: world velocity and acceleration, gravity 
     dY_i = ov_i x* Y_i - Y_i ov_i x + (. x* h_i)      (a 6 x 6 matrix)
 
 Pass 2, from the leaves, with ``Y``, ``dY``, ``of`` summed over the subtree of ``i``, for every
-dof ``k`` of body ``i``::
+dof ``k`` of body ``i`` its columns (kept for the ancestors' rows)::
 
     Fa_k = Y J_k,   Fq_k = dY dV_k + Y dA_k,   Fv_k = dY J_k + Y dAv_k,   YJ_k = dY^T J_k
-    M[l, k] = J_l . Fa_k,  dtau_dq[l, k] = J_l . Fq_k,  dtau_dv[l, k] = J_l . Fv_k
-                                                          (l a dof of i or of a descendant)
+
+and then, for every dof ``l`` of ``i`` or of a descendant (``Fa_l``, ``Fq_l``, ``Fv_l``, ``YJ_l``:
+the columns of ``l``'s own body, computed when it was visited)::
+
+    M[k, l] = M[l, k] = J_k . Fa_l,   dtau_dq[k, l] = J_k . Fq_l,   dtau_dv[k, l] = J_k . Fv_l
     dtau_dq[l, k] = Fa_l . dA_k + YJ_l . dV_k,  dtau_dv[l, k] = Fa_l . dAv_k + YJ_l . J_k
-                                                          (l a dof of a strict descendant)
-    then Fq_k += J_k x* of                 (the subtree turning rigidly, seen by the ancestors)
+                                                          (the second line: l in a strict descendant)
+
+after which ``Fq_k += J_k x* of`` (the subtree turning rigidly, seen by the ancestors' rows).
 
 External wrenches ``W_i`` (at the world origin) given in the body frame turn with their body
 and are part of the rigid ``of``. Given in world axes about the world origin they do not move:
@@ -172,7 +176,7 @@ def turn_force(turn, J, out):
 
 
 @inline
-def forward_pass(ints, dofs, v, a, a0, fext, fcode, oR, op, Ic, ov, oa, of, W, turn, dY, cols, Ym, A, t):
+def forward_pass(ints, v, a, a0, fext, fcode, oR, op, Ic, ov, oa, of, W, turn, dY, cols, Ym, A, t):
     """Pass 1 (see the module docstring): world motions, body forces, the columns ``dV, dA,
     dAv`` of every dof and the inertia variations ``dY``."""
     J, dV, dA, dAv = cols[0], cols[1], cols[2], cols[3]
@@ -229,7 +233,7 @@ def derivatives_state(ints, body, dofs, params, q, v, a, fext, fcode, check, dq,
         return status
     a0 = t[2]
     base_acceleration(params, a0)
-    forward_pass(ints, dofs, v, a, a0, fext, fcode, P[2], P[3], Ic, ov, oa, of, W, turn, dY, cols, Ym, A, t)
+    forward_pass(ints, v, a, a0, fext, fcode, P[2], P[3], Ic, ov, oa, of, W, turn, dY, cols, Ym, A, t)
     dq[:, :] = 0.0
     dv[:, :] = 0.0
     mass = M.shape[0] > 0
@@ -258,8 +262,9 @@ def derivatives_state(ints, body, dofs, params, q, v, a, fext, fcode, check, dq,
         mark[i] = i
         b = i
         while b < nb and ints[b, IV] < end:
-            if b > i:
-                if mark[ints[b, PARENT]] != i:
+            if b > i:  # in the subtree when its parent is (a parent below i never is)
+                p = ints[b, PARENT]
+                if p < i or mark[p] != i:
                     b += 1
                     continue
                 mark[b] = i
@@ -360,10 +365,10 @@ def fast_path(packed, model, q, v, x, friction, armature, check):
     state without external wrenches, or None when it does not take the arguments (then the
     general path checks them and says what is wrong)."""
     k, nv = model.kernel, model.nv
-    out = np.empty((3, nv, nv))
+    out = np.empty((nv, nv)), np.empty((nv, nv)), np.empty((nv, nv))
     try:
-        if packed(k.ints, k.packed[friction, armature], q, v, x, check, out[0], out[1], out[2]) == OK:
-            return out[0], out[1], out[2]
+        if packed(k.ints, k.packed[friction, armature], q, v, x, check, *out) == OK:
+            return out
     except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
         pass
     return None

@@ -1,7 +1,8 @@
 """Simulation: forward dynamics integrated in time, free or under a controller.
 
 ``simulate(model, q0, v0, duration, dt, controller=None, integrator="rk4")`` returns a
-:class:`Trajectory`; ``linearize`` gives the ``(A, B)`` of one of its steps; ``read_csv`` reads trajectories back (format in ``trajectory``).
+:class:`Trajectory`; ``linearize`` gives the ``(A, B)`` of one of its steps;
+``read_csv`` reads trajectories back (format in ``trajectory``).
 """
 
 from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, simulate

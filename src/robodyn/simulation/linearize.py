@@ -38,31 +38,26 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
-from ..lie import exp_se3, exp_so3, quat_matrix, quat_mul, right_jacobian_so3, skew
+from ..algorithms.integrate import check_configurations
+from ..lie import exp_se3, exp_so3, inverse_jacobian_coefficients, quat_matrix, quat_mul, right_jacobian_so3, skew
 from .simulate import INTEGRATORS
 
 
 def _acceleration_derivatives(model, q, v, tau):
     """``(a, Aq, Av, Bu)``: the simulator's acceleration for the command ``tau`` clipped to the
-    effort limits and its derivatives (``Bu``'s columns are zero for the clipped joints)."""
+    effort limits and its derivatives (``Bu``'s columns are zero for the joints at or beyond
+    their limit, whose clipped force does not change with the command: an effort limit of 0
+    makes a joint unactuated). The ABA runs again for ``a`` (``aba_derivatives`` computes it
+    inside and does not return it)."""
+    # imported here: importing the derivative kernels loads (or compiles) them, which
+    # `import robodyn.simulation` should not wait for
     from ..algorithms.aba import aba
     from ..algorithms.aba_derivatives import aba_derivatives
 
     limit = model.effort_limit
     clipped = np.clip(tau, -limit, limit)
-    Aq, Av, Minv = aba_derivatives(model, q, v, clipped)
-    return aba(model, q, v, clipped), Aq, Av, Minv * (np.abs(tau) <= limit)[..., None, :]
-
-
-def _inverse_jr_coefficients(t):
-    """``c(t)`` and ``c'(t) / t`` of ``Jr^-1`` (series below 1e-2, where the closed forms cancel)."""
-    small = t < 1e-2
-    ts = np.where(small, 1.0, t)
-    g = 1.0 - 0.5 * ts / np.tan(0.5 * ts)
-    dg = -0.5 / np.tan(0.5 * ts) + 0.25 * ts / np.sin(0.5 * ts) ** 2
-    c = np.where(small, 1 / 12 + t * t / 720, g / ts ** 2)
-    dc = np.where(small, 1 / 360 + t * t / 7560, dg / ts ** 3 - 2 * g / ts ** 4)
-    return c, dc
+    Aq, Av, Minv = aba_derivatives(model, q, v, clipped, check_finite=False)
+    return aba(model, q, v, clipped, check_finite=False), Aq, Av, Minv * (np.abs(tau) < limit)[..., None, :]
 
 
 def _chart(model, q0, theta, v):
@@ -86,7 +81,7 @@ def _chart(model, q0, theta, v):
         R, E, Jr = quat_matrix(quat), exp_so3(phi), right_jacobian_so3(phi)
         Et, P, W = np.swapaxes(E, -1, -2), skew(phi), skew(w)
         t = np.linalg.norm(phi, axis=-1)
-        c, dc = _inverse_jr_coefficients(t)
+        c, dc = inverse_jacobian_coefficients(t)
         c, dc = c[..., None, None], dc[..., None, None]
         Jr_inv = np.eye(3) + 0.5 * P + c * (P @ P)
         k[..., lin] = np.einsum("...ij,...j->...i", R, vl)
@@ -105,13 +100,13 @@ def _chart(model, q0, theta, v):
     return q, k, Dq0, Dth, Kq, Kth, Kv
 
 
-def linearize(model, q, v, tau, dt: float, integrator: str = "semi_implicit_euler") -> tuple[np.ndarray, np.ndarray]:
+def linearize(model, q, v, tau, dt: float, integrator: str = "rk4") -> tuple[np.ndarray, np.ndarray]:
     """``(A, B)`` of one step ``x+ = f(x, u)`` of :func:`simulate` from ``x = (q, v)`` under the
     joint force ``u = tau`` held for ``dt``, in tangent coordinates (see the module docstring).
 
     Args:
         q: (..., nq). v, tau: (..., nv). dt: the step, seconds (> 0).
-        integrator: ``"semi_implicit_euler"`` or ``"rk4"``, as in :func:`simulate`.
+        integrator: ``"rk4"`` (the default, as in :func:`simulate`) or ``"semi_implicit_euler"``.
 
     Returns:
         ``A`` (..., 2 nv, 2 nv) and ``B`` (..., 2 nv, nv), acting on ``[dq; dv]`` and ``du``.
@@ -121,14 +116,19 @@ def linearize(model, q, v, tau, dt: float, integrator: str = "semi_implicit_eule
     """
     if integrator not in INTEGRATORS:
         raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS}")
-    if not (isinstance(dt, (int, float, np.floating, np.integer)) and np.isfinite(dt) and dt > 0):
+    if isinstance(dt, (bool, np.bool_)) or not (isinstance(dt, (int, float, np.floating, np.integer))
+                                                 and np.isfinite(dt) and dt > 0):
         raise ValueError(f"dt: expected a positive number of seconds, got {dt!r}")
     arrays = {}
     for name, x, size in (("q", q, model.nq), ("v", v, model.nv), ("tau", tau, model.nv)):
-        x = np.asarray(x, dtype=float)
+        try:
+            x = np.asarray(x, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"{name}: expected an array of numbers, got {type(x).__name__}") from None
         if x.ndim == 0 or x.shape[-1] != size:
             raise ValueError(f"{name}: expected shape (..., {size}), got {x.shape}")
         arrays[name] = x
+    check_configurations(model, True, "linearize", **arrays)
     try:
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays.values()))
     except ValueError:
@@ -170,4 +170,4 @@ def _step(model, q0, v, tau, dt, stages, euler):
     dq_next = Dq0 @ Iq + Dth @ dtheta_next
     dv_next = Iv + dt / total * da_sum
     J_ = np.concatenate([dq_next, dv_next], -2)
-    return J_[..., :2 * n], J_[..., 2 * n:]
+    return np.ascontiguousarray(J_[..., :2 * n]), np.ascontiguousarray(J_[..., 2 * n:])
