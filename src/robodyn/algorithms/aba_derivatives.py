@@ -8,7 +8,9 @@ Forward dynamics inverts inverse dynamics: ``rnea(q, v, aba(q, v, tau)) = tau`` 
 so ``dqdd/dq = -M^-1 dtau/dq``, ``dqdd/dv = -M^-1 dtau/dv`` and ``dqdd/dtau = M^-1``, with the
 partial derivatives of the RNEA (``rnea_derivatives.py``) taken at ``(q, v, qdd)`` and ``M^-1``
 from the O(n^2) recursion of ``minv.py`` (``M`` includes the armature when it is on; friction
-and external wrenches enter through ``dtau/dq`` and ``dtau/dv``). Derivatives with respect to
+and external wrenches enter through ``dtau/dq`` and ``dtau/dv``). With ``M^-1`` at hand, the
+acceleration is ``qdd = M^-1 (tau - h)``, ``h = rnea(q, v, 0)`` (cheaper than a second
+articulated-body pass; both carry the rounding of a solve with ``M``). Derivatives with respect to
 ``q`` are in the tangent space of :func:`robodyn.integrate`, as Pinocchio's
 ``computeABADerivatives``.
 
@@ -23,20 +25,21 @@ from numba import boolean
 
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from . import _inputs
-from . import aba as _aba
+from . import rnea as _rnea
 from . import minv as _minv
 from . import rnea_derivatives as _rd
 from ._inputs import fits, unpack
 from .driver import batch_kernel, chunks
-from .status import NO_WRENCH, OK, WRONG_SIZE, finite2, raise_for_status, raise_singular, result_status
+from .status import (NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, finite2, raise_for_status, raise_singular,
+                     result_status)
 
 
 @kernel
 def workspace(nb, nv):
-    """Scratch of :func:`derivatives_one`: the workspaces of the ABA, the RNEA derivatives and
-    ``M^-1``, then ``(qdd, dtau_dq, dtau_dv, an empty M)``."""
-    return (_aba.workspace(nb, nv), _rd.workspace(nb, nv), _minv.workspace(nb, nv),
-            (np.empty(nv), np.empty((nv, nv)), np.empty((nv, nv)), np.empty((0, 0))))
+    """Scratch of :func:`derivatives_one`: the workspaces of the RNEA, its derivatives and
+    ``M^-1``, then ``(qdd, h, dtau_dq, dtau_dv, an empty M)``."""
+    return (_rnea.workspace(nb), _rd.workspace(nb, nv), _minv.workspace(nb, nv),
+            (np.empty(nv), np.empty(nv), np.empty((nv, nv)), np.empty((nv, nv)), np.empty((0, 0))))
 
 
 @inline
@@ -65,14 +68,26 @@ def neg_product(A, B, out):
 def derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv, ws):
     """``da_dq``, ``da_dv`` and ``Minv = da_dtau`` (nv, nv) at one state; returns a status (see
     ``_inputs``), ``i + 1`` when the articulated inertia of body ``i`` is singular."""
-    aba_ws, rd_ws, minv_ws, (qdd, dq, dv, M0) = ws
-    status = _aba.aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, aba_ws)
+    rnea_ws, rd_ws, minv_ws, (qdd, b, dq, dv, M0) = ws
+    nv = dofs.shape[0]
+    if tau.shape[0] != nv:
+        return WRONG_SIZE
+    if check and not finite(tau):
+        return NONFINITE
+    status = _minv.minv_one(ints, body, dofs, q, check, Minv, minv_ws)
     if status != OK:
         return status
+    for k in range(nv):
+        qdd[k] = 0.0
+    status = _rnea.rnea_one(ints, body, dofs, params, q, v, qdd, fext, fcode, check, b, rnea_ws)
+    if status != OK:
+        return status
+    for r in range(nv):  # qdd = M^-1 (tau - h)
+        s = 0.0
+        for k in range(nv):
+            s += Minv[r, k] * (tau[k] - b[k])
+        qdd[r] = s
     status = _rd.derivatives_one(ints, body, dofs, params, q, v, qdd, fext, fcode, False, dq, dv, M0, rd_ws)
-    if status != OK:
-        return status
-    status = _minv.minv_one(ints, body, dofs, q, False, Minv, minv_ws)
     if status != OK:
         return status
     neg_product(Minv, dq, da_dq)
