@@ -4,9 +4,9 @@
 
 Robots from example-robot-data: Panda (fixed base), Solo12 and Talos reduced (floating base).
 For ``rnea_derivatives`` and ``aba_derivatives``: single calls from Python against Pinocchio's
-``computeRNEADerivatives`` / ``computeABADerivatives`` (timed in alternating rounds), the
-per-state time of a batch against a Python loop over Pinocchio (which has no batched
-derivatives), and ``aba_derivatives`` against central finite differences of ``aba`` (one
+``computeRNEADerivatives`` / ``computeABADerivatives``, the per-state time of a batch against
+a Python loop over Pinocchio (which has no batched derivatives), each pair timed in alternating
+rounds, and ``aba_derivatives`` against central finite differences of ``aba`` (one
 batched ``aba`` call on the ``4 nv`` perturbed states, step 1e-6): time and accuracy. Every
 result is checked against Pinocchio (relative error printed). Ratio: robodyn / other, below 1
 robodyn is faster.
@@ -23,7 +23,7 @@ import numba
 import numpy as np
 
 import robodyn as rd
-from robodyn.bench import Timing, format_table, paired_us, per_call_us, rel_error
+from robodyn.bench import Timing, format_table, paired_us, rel_error
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from compare import erd_urdf  # noqa: E402
@@ -43,6 +43,13 @@ def aba_by_differences(model, q, v, tau):
     out = rd.aba(model, Q, V, np.broadcast_to(tau, (4 * n, n)), friction=False)
     d = (out[:n] - out[n:2 * n]) / (2 * STEP), (out[2 * n:3 * n] - out[3 * n:]) / (2 * STEP)
     return d[0].T, d[1].T
+
+
+def per_state(ours, n_ours: int, theirs, n_theirs: int) -> tuple[float, float]:
+    """Microseconds per state of two batched calls, timed in alternating rounds (best of 15:
+    a batch takes tens of milliseconds, and the host's speed drifts between seconds)."""
+    a, b = paired_us(ours, theirs, rounds=15)
+    return a / n_ours, b / n_theirs
 
 
 def section(name: str, relpath: str, floating: bool, batch: int) -> str:
@@ -77,14 +84,12 @@ def section(name: str, relpath: str, floating: bool, batch: int) -> str:
                                               lambda: pin.computeRNEADerivatives(pm, data, q, v, a))),
         Timing("aba_derivatives", *paired_us(lambda: rd.aba_derivatives(model, q, v, tau, **kw),
                                              lambda: pin.computeABADerivatives(pm, data, q, v, tau))),
-        Timing("rnea_derivatives (batch) / loop",
-               per_call_us(lambda: rd.rnea_derivatives(model, Q, V, A, **kw)) / batch,
-               per_call_us(lambda: [pin.computeRNEADerivatives(pm, data, *x) for x in zip(Q[:Bn], V[:Bn], A[:Bn])])
-               / Bn),
-        Timing("aba_derivatives (batch) / loop",
-               per_call_us(lambda: rd.aba_derivatives(model, Q, V, T, **kw)) / batch,
-               per_call_us(lambda: [pin.computeABADerivatives(pm, data, *x) for x in zip(Q[:Bn], V[:Bn], T[:Bn])])
-               / Bn),
+        Timing("rnea_derivatives (batch) / loop", *per_state(
+            lambda: rd.rnea_derivatives(model, Q, V, A, **kw), batch,
+            lambda: [pin.computeRNEADerivatives(pm, data, *x) for x in zip(Q[:Bn], V[:Bn], A[:Bn])], Bn)),
+        Timing("aba_derivatives (batch) / loop", *per_state(
+            lambda: rd.aba_derivatives(model, Q, V, T, **kw), batch,
+            lambda: [pin.computeABADerivatives(pm, data, *x) for x in zip(Q[:Bn], V[:Bn], T[:Bn])], Bn)),
         Timing("aba_derivatives / aba differences", *paired_us(lambda: rd.aba_derivatives(model, q, v, tau, **kw),
                                                                lambda: aba_by_differences(model, q, v, tau))),
     ]
