@@ -8,11 +8,11 @@ with a motor on the elbow only: the acrobot, modelled by an effort limit of 0 at
 ``B`` as 0). The upright equilibrium ``(q, v) = 0`` needs no torque. ``rd.linearize`` gives
 the discrete-time ``(A, B)`` of one RK4 step of ``dt``; the elbow's column of ``B`` is the
 acrobot's input. The controller is evaluated at every stage of the simulator's RK4 steps,
-close to (not exactly) the torque held over a step that the design assumes. The discrete algebraic Riccati equation gives
-the gain ``K`` of ``u = -K [q ⊖ q*; v]``, and ``rd.simulate`` runs the nonlinear robot from a
-push (an initial velocity) under that law. Reference: Spong, "The swing up control problem
-for the Acrobot", IEEE Control Systems 1995 (the acrobot); Anderson and Moore, *Optimal
-Control: Linear Quadratic Methods* (1990), ch. 2 (discrete LQR).
+close to (not exactly) the torque held over a step that the design assumes. The discrete
+algebraic Riccati equation gives the gain ``K`` of ``u = -K [q ⊖ q*; v]``, and ``rd.simulate``
+runs the nonlinear robot from a push (an initial velocity) under that law. Reference: Spong,
+"The swing up control problem for the Acrobot", IEEE Control Systems 1995 (the acrobot);
+Anderson and Moore, *Optimal Control: Linear Quadratic Methods* (1990), ch. 2 (discrete LQR).
 """
 
 from __future__ import annotations

@@ -45,8 +45,9 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
         q: (..., nq) configuration (unit quaternions for free joints). v: (..., nv).
 
     Returns:
-        (..., nq), unit quaternions of the sign nearer ``q``'s (``q_quat . out_quat >= 0``). Equals Pinocchio's ``integrate(model, q, v)``;
-        ``difference(model, q, integrate(model, q, v)) == v`` for rotations below pi.
+        (..., nq), unit quaternions of the sign nearer ``q``'s (``q_quat . out_quat >= 0``).
+        Equals Pinocchio's ``integrate(model, q, v)``; ``difference(model, q, integrate(model,
+        q, v)) == v`` for rotations below pi.
     Reference: Lynch and Park, *Modern Robotics*, eq. (3.88).
     """
     batch, x = _inputs.states(model, q=q, v=v)
