@@ -22,10 +22,12 @@ import warnings
 from pathlib import Path
 
 import numba
+import numpy as np
 
 ROBOTS = {"panda": ("panda_description/urdf/panda.urdf", False),
           "talos": ("talos_data/robots/talos_reduced.urdf", True)}
-ARGS = {"rnea": "QVA", "aba": "QVA", "crba": "Q", "coriolis_matrix": "QV", "inverse_mass_matrix": "Q"}
+ARGS = {"rnea": "QVA", "aba": "QVA", "crba": "Q", "coriolis_matrix": "QV", "inverse_mass_matrix": "Q",
+        "rnea_derivatives": "QVA", "aba_derivatives": "QVA"}
 
 
 def import_revision(rev: str):
@@ -79,7 +81,7 @@ def main() -> None:
         for call in args.calls.split(","):
             inputs = [x[k] for k in ARGS[call]]
             f_new, f_old = getattr(rd, call), getattr(ro, call)
-            err = rel_error(f_new(new, *inputs), f_old(old, *inputs))
+            err = rel_error(np.asarray(f_new(new, *inputs)), np.asarray(f_old(old, *inputs)))  # tuples: stacked
             t_new, t_old = paired_us(lambda: f_new(new, *inputs), lambda: f_old(old, *inputs), rounds=args.rounds)
             cells.append(f"{call} {t_old / per:.3f} -> {t_new / per:.3f} ({t_new / t_old:.2f}), diff {err:.0e}")
         print(f"{name}: " + " | ".join(cells))

@@ -44,24 +44,31 @@ def workspace(nb, nv):
 
 @inline
 def neg_product(A, B, out):
-    """``out = -A B`` for square (n, n) matrices: row by row of ``out``, four rows of ``B`` at a
-    time (contiguous inner loops; each pass over a row of ``out`` does four multiply-adds)."""
+    """``out = -A B`` for square (n, n) matrices: row by row of ``out``, eight rows of ``B`` at
+    a time, then four, then one (contiguous inner loops; each pass over a row of ``out`` does
+    several multiply-adds)."""
     n = A.shape[0]
     for r in range(n):
         for c in range(n):
             out[r, c] = 0.0
         k = 0
+        while k + 8 <= n:
+            x0, x1, x2, x3 = A[r, k], A[r, k + 1], A[r, k + 2], A[r, k + 3]
+            x4, x5, x6, x7 = A[r, k + 4], A[r, k + 5], A[r, k + 6], A[r, k + 7]
+            for c in range(n):
+                out[r, c] -= (x0 * B[k, c] + x1 * B[k + 1, c] + x2 * B[k + 2, c] + x3 * B[k + 3, c]
+                              + x4 * B[k + 4, c] + x5 * B[k + 5, c] + x6 * B[k + 6, c] + x7 * B[k + 7, c])
+            k += 8
+        if k + 4 <= n:
+            x0, x1, x2, x3 = A[r, k], A[r, k + 1], A[r, k + 2], A[r, k + 3]
+            for c in range(n):
+                out[r, c] -= x0 * B[k, c] + x1 * B[k + 1, c] + x2 * B[k + 2, c] + x3 * B[k + 3, c]
+            k += 4
         while k < n:
-            if k + 4 <= n:
-                x0, x1, x2, x3 = A[r, k], A[r, k + 1], A[r, k + 2], A[r, k + 3]
-                for c in range(n):
-                    out[r, c] -= x0 * B[k, c] + x1 * B[k + 1, c] + x2 * B[k + 2, c] + x3 * B[k + 3, c]
-                k += 4
-            else:
-                x0 = A[r, k]
-                for c in range(n):
-                    out[r, c] -= x0 * B[k, c]
-                k += 1
+            x0 = A[r, k]
+            for c in range(n):
+                out[r, c] -= x0 * B[k, c]
+            k += 1
 
 
 @core
