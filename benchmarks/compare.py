@@ -44,7 +44,9 @@ def erd_urdf(relpath: str) -> str:
     return str(base / relpath)
 
 
-def pinocchio_section(name: str, relpath: str, floating: bool, batch: int) -> str:
+def load_pair(name: str, relpath: str, floating: bool):
+    """robodyn's and Pinocchio's models of one example-robot-data URDF, ``(model, pin_model)``,
+    with the same configuration layout (a continuous joint would differ: refused)."""
     import pinocchio as pin
 
     f = erd_urdf(relpath)
@@ -54,6 +56,13 @@ def pinocchio_section(name: str, relpath: str, floating: bool, batch: int) -> st
     pm = pin.buildModelFromUrdf(f, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(f)
     if pm.nq != model.nq:
         raise SystemExit(f"{name}: continuous joints make the q layouts differ; pick another robot")
+    return model, pm
+
+
+def pinocchio_section(name: str, relpath: str, floating: bool, batch: int) -> str:
+    import pinocchio as pin
+
+    model, pm = load_pair(name, relpath, floating)
     single = single_call_timings(model, pm)
     batched = batch_timings(model, batch, pm)
     errors = agreement(model, pm, batch)

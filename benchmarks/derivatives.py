@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import warnings
 from pathlib import Path
 
 import numba
@@ -26,7 +25,7 @@ import robodyn as rd
 from robodyn.bench import Timing, format_table, paired_us, rel_error
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from compare import erd_urdf  # noqa: E402
+from compare import load_pair  # noqa: E402
 
 ROBOTS = [("Panda", "panda_description/urdf/panda.urdf", False),
           ("Solo12", "solo_description/robots/solo12.urdf", True),
@@ -55,13 +54,7 @@ def per_state(ours, n_ours: int, theirs, n_theirs: int) -> tuple[float, float]:
 def section(name: str, relpath: str, floating: bool, batch: int) -> str:
     import pinocchio as pin
 
-    f = erd_urdf(relpath)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        model = rd.load_urdf(f, floating_base=floating)
-    pm = pin.buildModelFromUrdf(f, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(f)
-    if pm.nq != model.nq:
-        raise SystemExit(f"{name}: continuous joints make the q layouts differ; pick another robot")
+    model, pm = load_pair(name, relpath, floating)
     data = pm.createData()
     rng = np.random.default_rng(0)
     q, v, a = rd.random.random_state(model, rng)

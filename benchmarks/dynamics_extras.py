@@ -14,7 +14,6 @@ microseconds per call; the ratio is robodyn / other (below 1: robodyn is faster)
 from __future__ import annotations
 
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -23,17 +22,13 @@ import robodyn as rd
 from robodyn.bench import Timing, format_table, per_call_us
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from compare import erd_urdf  # noqa: E402
+from compare import load_pair  # noqa: E402
 
 
 def section(name: str, relpath: str, floating: bool, batch: int = 10000) -> str:
     import pinocchio as pin
 
-    f = erd_urdf(relpath)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        model = rd.load_urdf(f, floating_base=floating)
-    pm = pin.buildModelFromUrdf(f, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(f)
+    model, pm = load_pair(name, relpath, floating)
     data = pm.createData()
     rng = np.random.default_rng(0)
     q, v, a = rd.random.random_state(model, rng)

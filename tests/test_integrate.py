@@ -42,13 +42,19 @@ def test_random_trees_agree_with_pinocchio(model):
         np.testing.assert_allclose(rd.difference(model, q, q1), pin.difference(pm, q, q1), rtol=0, atol=1e-10)
 
 
-@pytest.mark.parametrize("path", FLOATING_URDFS)
-def test_floating_base_urdfs_agree_with_pinocchio(path):
+def floating_pair(path):
+    """robodyn's and Pinocchio's floating-base models of an example-robot-data URDF."""
     full = str(example_robot_data_dir() / path)
     pm = pin.buildModelFromUrdf(full, pin.JointModelFreeFlyer())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
         model = rd.load_urdf(full, floating_base=True, physical="warn")
+    return model, pm
+
+
+@pytest.mark.parametrize("path", FLOATING_URDFS)
+def test_floating_base_urdfs_agree_with_pinocchio(path):
+    model, pm = floating_pair(path)
     assert (model.nq, model.nv) == (pm.nq, pm.nv) and list(model.body_joint_names) == list(pm.names[1:])
     rng = rng_for(path)
     q, q1 = random_configuration(model, rng), random_configuration(model, rng)
@@ -169,11 +175,7 @@ def test_jacobians_are_the_differences(model):
 
 @pytest.mark.parametrize("path", FLOATING_URDFS[:1])
 def test_jacobians_on_a_floating_urdf_agree_with_pinocchio(path):
-    full = str(example_robot_data_dir() / path)
-    pm = pin.buildModelFromUrdf(full, pin.JointModelFreeFlyer())
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", rd.RobodynWarning)
-        model = rd.load_urdf(full, floating_base=True, physical="warn")
+    model, pm = floating_pair(path)
     rng = rng_for(path, "jacobians")
     q, q1 = random_configuration(model, rng), random_configuration(model, rng)
     v = rng.standard_normal(model.nv)

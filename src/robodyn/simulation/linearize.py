@@ -156,12 +156,12 @@ def _step(model, q0, v, tau, dt, stages, euler):
         if k is not None:
             theta, dtheta = c * dt * k, c * dt * dk
             vs, dvs = v + c * dt * a, Iv + c * dt * da
-        qs, _, Dq0, Dth, _, _, _ = _chart(model, q0, theta, vs)
+        qs, k, Dq0, Dth, Kq, Kth, Kv = _chart(model, q0, theta, vs)
         a, Aq, Av, Bu = _acceleration_derivatives(model, qs, vs, tau)
         da = Aq @ (Dq0 @ Iq + Dth @ dtheta) + Av @ dvs + Bu @ Iu
-        if euler:  # the chart moves with the new velocity
+        if euler:  # the chart moves with the new velocity: its rate at v+
             vs, dvs = v + dt * a, Iv + dt * da
-        _, k, _, _, Kq, Kth, Kv = _chart(model, q0, theta, vs)
+            _, k, _, _, Kq, Kth, Kv = _chart(model, q0, theta, vs)
         dk = Kq @ Iq + Kth @ dtheta + Kv @ dvs
         k_sum, dk_sum = k_sum + weight * k, dk_sum + weight * dk
         a_sum, da_sum = a_sum + weight * a, da_sum + weight * da
