@@ -215,7 +215,6 @@ BAD_FILES = [
     ("inertia_not_psd.urdf", "<link name='arm'> <inertial>", "not positive semi-definite"),
     ("triangle_inequality.urdf", "<link name='arm'> <inertial>", "triangle inequality"),
     ("zero_axis.urdf", "<joint name='j1'>", "joint axis is zero"),
-    ("limits_reversed.urdf", "<joint name='j1'>", "exceeds upper limit"),
     ("wrong_number_count.urdf", "<origin>", "needs 3 number(s)"),
     ("billion_laughs.urdf", "<!DOCTYPE lolz>", "forbidden"),
     ("external_entity.urdf", "<!DOCTYPE robot>", "forbidden"),
@@ -557,3 +556,91 @@ def test_floating_base_layout():
     assert model.frame_index("head")[0] == 0
     assert np.all(np.isinf(model.lower[:6])) and np.all(np.isinf(model.upper[:6]))
     assert model.total_mass == 11.5 and fixed.total_mass == 1.0
+
+
+# ----------------------------------------------------------------------------------------
+# files from the wild that the major loaders read
+# ----------------------------------------------------------------------------------------
+
+_ARM = (_link("base", 2.0) + _link("arm", 1.0, xyz="0.1 0 0.2")
+        + _joint("j", "revolute", "base", "arm", xyz="0 0 0.3", axis="0 1 0",
+                 extra='<limit lower="-1" upper="1" effort="5" velocity="2"/>'))
+
+
+def _same_model(a, b):
+    for field in ("parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "lower", "upper"):
+        np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=field)
+    assert a.link_names == b.link_names and a.joint_names == b.joint_names
+
+
+def test_reversed_limits_load_unbounded_with_warning(fixture_path):
+    """PyBullet reads lower > upper as no limit; robodyn too, with a warning naming the joint."""
+    path = fixture_path("limits_reversed.urdf")
+    with pytest.warns(rd.RobodynWarning, match=r"lower > upper loaded as unbounded: j1 \(1 > -1\)") as rec:
+        model = rd.load_urdf(path)
+    assert str(path) in str(rec[0].message)
+    assert (model.lower[0], model.upper[0]) == (-np.inf, np.inf)
+    assert (model.effort_limit[0], model.velocity_limit[0]) == (10.0, 2.0)
+
+
+@pytest.mark.parametrize("head", ["\ufeff", "\n\n  ", "\ufeff\r\n\t"], ids=["bom", "blank-lines", "bom-and-blanks"])
+def test_byte_order_mark_and_whitespace_before_the_declaration(tmp_path, head):
+    text = head + '<?xml version="1.0" encoding="utf-8"?>\n' + _robot(_ARM)
+    path = tmp_path / "lead.urdf"
+    path.write_bytes(text.encode("utf-8"))
+    reference = rd.load_urdf(_robot(_ARM))
+    for source in (path, text):
+        _same_model(rd.load_urdf(source), reference)
+    # line numbers still count the leading lines
+    bad = head + '<?xml version="1.0"?>\n<robot name="r">\n<link name="a"/>\n<link/>\n</robot>'
+    with pytest.raises(rd.ModelError, match=rf"<link> \(line {4 + head.count(chr(10))}\): link without a name"):
+        rd.load_urdf(bad)
+
+
+def test_default_namespace_on_robot():
+    text = _robot(_ARM).replace('<robot name="test">', '<robot name="test" xmlns="http://example.org/urdf">')
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _same_model(rd.load_urdf(text), rd.load_urdf(_robot(_ARM)))
+
+
+@pytest.mark.parametrize("declared", [True, False], ids=["declared", "undeclared"])
+def test_extension_elements_in_a_namespace_are_ignored(declared):
+    """``<drake:joint>`` and namespaced attributes, with ``xmlns:drake`` declared or not: the
+    extension elements are listed in the one warning, and nothing of them is read as URDF."""
+    extra = ('<drake:joint name="planar_x" type="planar"><drake:parent link="base"/></drake:joint>'
+             '<link name="tool" drake:collision_filter="x"/>'
+             + _joint("tool_fixed", "fixed", "arm", "tool"))
+    text = _robot(_ARM, extra)
+    if declared:
+        text = text.replace('<robot name="test">', '<robot name="test" xmlns:drake="http://drake.mit.edu">')
+    uri = "http://drake.mit.edu" if declared else "urn:undeclared:drake"
+    with pytest.warns(rd.RobodynWarning, match=re.escape(f"1 <{{{uri}}}joint>")):
+        model = rd.load_urdf(text)
+    assert model.nv == 1 and model.joint_names == ("j",) and "tool" in model.frame_names
+
+
+def test_floating_joint_is_a_free_joint_under_the_world():
+    """A ``floating`` joint from a link welded to the world is a free joint, as in Pinocchio
+    (JointModelFreeFlyer at the joint origin); under a moving link it is refused."""
+    text = _robot(_link("world"), _ARM.replace('_link("base"', ''),
+                  _joint("float", "floating", "world", "base", xyz="0.5 -0.2 1.0", rpy="0.1 0.2 0.3"))
+    model = rd.load_urdf(text)
+    assert model.floating_base and model.nq == 8 and model.nv == 7
+    assert model.body_joint_names == ("float", "j") and "world" in model.frame_names
+    np.testing.assert_allclose(model.X_tree_p[0], [0.5, -0.2, 1.0])
+    pm = pin.buildModelFromXML(text)
+    assert pm.joints[1].shortname() == "JointModelFreeFlyer"
+    rng = np.random.default_rng(3)
+    q = np.concatenate([rng.normal(size=3), Rotation.random(random_state=4).as_quat(), [0.4]])
+    v, a = rng.normal(size=7), rng.normal(size=7)
+    pd = pm.createData()
+    np.testing.assert_allclose(rd.rnea(model, q, v, a), pin.rnea(pm, pd, q, v, a), rtol=1e-10, atol=1e-10)
+    with pytest.raises(rd.ModelError, match=r"joint name='float'.*a free joint must attach to the world, but its "
+                                            r"parent link 'arm' moves with body 'arm'"):
+        rd.load_urdf(_robot(_ARM, _link("box", 1.0), _joint("float", "floating", "arm", "box")))
+
+
+def test_planar_joint_is_refused_with_its_name():
+    with pytest.raises(rd.ModelError, match=r"<joint name='p'> \(line \d+\): joint type 'planar' is not supported"):
+        rd.load_urdf(_robot(_ARM, _link("box", 1.0), _joint("p", "planar", "arm", "box")))

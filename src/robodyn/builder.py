@@ -33,7 +33,8 @@ from . import joints as J
 from .errors import RobodynWarning
 from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from, inertial_parameters_in_parent
 
-JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "fixed": None}
+JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
+               "fixed": None}
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -142,7 +143,11 @@ class ModelBuilder:
                   upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
                   armature=0.0, where: str | None = None) -> None:
         """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
-        in the parent link frame and the child frame coincides with it at ``q = 0``."""
+        in the parent link frame and the child frame coincides with it at ``q = 0``.
+
+        ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``fixed`` or ``free`` (a
+        6-dof joint, whose parent link must be the root or welded to it: its configuration
+        ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame)."""
         where = where or f"{self.source}: joint {name!r}"
         if type not in JOINT_TYPES:
             raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted(JOINT_TYPES)}")
@@ -153,12 +158,14 @@ class ModelBuilder:
             if not np.all(np.isfinite(a)):
                 raise ModelError(f"{where}: {what} is not finite")
         R = rpy_to_matrix(rot) if rotation is None else rot
-        if type != "fixed":
+        if type == "free":
+            ax = np.zeros(3)
+        elif type != "fixed":
             n = np.linalg.norm(ax)
             if n < 1e-12:
                 raise ModelError(f"{where}: joint axis is zero")
             ax = ax / n
-        if type == "continuous":
+        if type in ("continuous", "free"):
             lower, upper = -np.inf, np.inf
         limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
                       effort=float(effort), damping=float(damping), friction=float(friction),
@@ -257,6 +264,11 @@ class ModelBuilder:
             if jt.type == "fixed":
                 place[jt.child] = (b, Rj, pj)
                 frames.append((jt.child, b, Rj, pj))
+            elif jt.type == "free" and b >= 0:
+                raise ModelError(
+                    f"{jt.where}: a free joint must attach to the world, but its parent link "
+                    f"{jt.parent!r} moves with body {names[b]!r}"
+                )
             else:
                 nb = new_body(b, JOINT_TYPES[jt.type], jt.axis, Rj, pj, jt.child, jt.name, jt.limits)
                 place[jt.child] = (nb, np.eye(3), np.zeros(3))

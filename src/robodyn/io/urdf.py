@@ -1,7 +1,8 @@
 """URDF loader: ``load_urdf(path_or_xml_string, floating_base=False) -> Model``.
 
 Reads links (``<inertial>`` with origin xyz/rpy applied as ``R I R^T``), and joints of type
-revolute, continuous, prismatic and fixed (merged into the parent body), with ``<origin>``,
+revolute, continuous, prismatic, fixed (merged into the parent body) and floating (a free
+joint; its parent link must be the root or welded to it), with ``<origin>``,
 ``<axis>`` (normalised; zero is an error), ``<limit lower upper velocity effort>`` (lower and
 upper default to 0 as in the URDF specification; a joint without ``<limit>`` is unbounded,
 continuous joints always are), ``<dynamics damping friction>``.
@@ -10,6 +11,11 @@ dynamics (material, gazebo, transmission, joint calibration and safety_controlle
 reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
 dynamics and is skipped without a warning.
 
+Lenient where the major loaders are: a byte-order mark or blank lines before ``<?xml ...?>``,
+a default ``xmlns`` on ``<robot>``, extension elements and attributes in other namespaces
+(``<drake:joint>``, with ``xmlns:drake`` declared or not: listed in the warning, not read), a
+``<limit>`` with lower > upper (no limit, as PyBullet reads it, with a warning).
+
 XML is parsed with DTDs, entities and external references forbidden (defusedxml). Every
 error is a :class:`~robodyn.model.ModelError` naming the file, the element and its line.
 Files are limited to ``MAX_FILE_BYTES`` bytes and ``MAX_DEPTH`` levels of nesting.
@@ -17,109 +23,23 @@ Files are limited to ``MAX_FILE_BYTES`` bytes and ``MAX_DEPTH`` levels of nestin
 
 from __future__ import annotations
 
-import os
 import warnings
 from collections import Counter
-from pathlib import Path
 
 import numpy as np
-from defusedxml import DefusedXmlException, DTDForbidden
-from defusedxml.ElementTree import DefusedXMLParser, ParseError
 
 from ..builder import ModelBuilder, rpy_to_matrix
 from ..errors import ModelError, RobodynWarning
 from ..model import Model
+from ._xml import MAX_DEPTH, parse, read_source
+
+__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "load_urdf"]
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
-MAX_DEPTH = 64
-
-
-class _LineParser(DefusedXMLParser):
-    """DefusedXMLParser that records the line of every element and bounds the nesting."""
-
-    def __init__(self):
-        super().__init__(forbid_dtd=True, forbid_entities=True, forbid_external=True)
-        self.lines: dict[int, int] = {}
-        self._depth = 0
-
-    def _start(self, tag, attr_list):
-        self._depth += 1
-        if self._depth > MAX_DEPTH:
-            raise ModelError(
-                f"<{tag}> (line {self.parser.CurrentLineNumber}): elements nested deeper than {MAX_DEPTH} levels"
-            )
-        elem = super()._start(tag, attr_list)
-        self.lines[id(elem)] = self.parser.CurrentLineNumber
-        return elem
-
-    def _end(self, tag):
-        self._depth -= 1
-        return super()._end(tag)
 
 
 def _read_source(source) -> tuple[str, str]:
-    """``(xml_text, name)`` from a path or an XML string."""
-    if isinstance(source, str) and not source.strip():
-        raise ModelError("<string>: empty input: expected a URDF path or XML text")
-    if isinstance(source, (str, os.PathLike)) and not (isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")):
-        path = Path(source)
-        try:
-            is_file = path.is_file()
-            size = path.stat().st_size if is_file else 0
-        except (OSError, ValueError) as e:
-            raise ModelError(f"{path}: cannot read URDF file ({getattr(e, 'strerror', None) or e})") from None
-        if not is_file:
-            reason = "not a regular file" if path.exists() else "no such file"
-            raise ModelError(f"{path}: cannot read URDF file ({reason})")
-        if size > MAX_FILE_BYTES:
-            raise ModelError(f"{path}: file of {size} bytes exceeds the limit of {MAX_FILE_BYTES} bytes")
-        try:
-            return path.read_bytes().decode("utf-8"), str(path)
-        except OSError as e:
-            raise ModelError(f"{path}: cannot read URDF file ({e.strerror or e})") from None
-        except UnicodeDecodeError as e:
-            raise ModelError(f"{path}: not UTF-8 text ({e})") from None
-    if isinstance(source, bytes):
-        source = source.decode("utf-8", errors="strict")
-    if not isinstance(source, str):
-        raise TypeError(f"load_urdf expects a path or an XML string, got {type(source).__name__}")
-    if len(source) > MAX_FILE_BYTES:
-        raise ModelError(f"<string>: XML of {len(source)} characters exceeds the limit of {MAX_FILE_BYTES}")
-    return source, "<string>"
-
-
-def _source_line(text: str, line) -> str:
-    """The stripped text of a 1-based line (shortened), to show where the XML breaks."""
-    lines = text.splitlines()
-    if not isinstance(line, int) or not 1 <= line <= len(lines):
-        return ""
-    snippet = lines[line - 1].strip()
-    return f": {snippet[:80] + ('...' if len(snippet) > 80 else '')!r}"
-
-
-def _parse(text: str, name: str):
-    parser = _LineParser()
-    try:
-        parser.feed(text)
-        root = parser.close()
-    except ParseError as e:
-        line = e.position[0] if getattr(e, "position", None) else "?"
-        raise ModelError(f"{name}: line {line}{_source_line(text, line)}: malformed XML ({e})") from None
-    except DefusedXmlException as e:
-        line = parser.parser.CurrentLineNumber
-        if isinstance(e, DTDForbidden):
-            what = f"<!DOCTYPE {e.name}>"
-        else:
-            what = f"<!ENTITY {e.name}>" if hasattr(e, "name") else "external reference"
-        raise ModelError(
-            f"{name}: {what} (line {line}): forbidden XML construct ({type(e).__name__}); "
-            "DTDs and entities are not allowed"
-        ) from None
-    except ModelError as e:
-        raise ModelError(f"{name}: {e}") from None
-    except RecursionError:
-        raise ModelError(f"{name}: XML nested too deeply") from None
-    return root, parser.lines
+    return read_source(source, "URDF", MAX_FILE_BYTES)
 
 
 class _Reader:
@@ -174,13 +94,13 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     follow the order Pinocchio gives the same file.
     """
     text, name = _read_source(source)
-    root, lines = _parse(text, name)
+    root, lines = parse(text, name)
     rd = _Reader(name, lines)
     if root.tag != "robot":
         raise ModelError(f"{rd.where(root)}: root element must be <robot>, got <{root.tag}>")
     b = ModelBuilder(root.get("name", "robot"), gravity=gravity, source=name, physical=physical)
     ignored: Counter[str] = Counter()
-    mimic = []
+    mimic, reversed_limits = [], []
     joint_elems = []
     for elem in root:
         if not isinstance(elem.tag, str):
@@ -196,7 +116,12 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
         if elem.find("mimic") is not None:
             mimic.append(elem.get("name"))
-        _read_joint(rd, b, elem, ignored)
+        _read_joint(rd, b, elem, ignored, reversed_limits)
+    if reversed_limits:
+        warnings.warn(
+            f"{name}: joint limits with lower > upper loaded as unbounded: {', '.join(reversed_limits)}",
+            RobodynWarning, stacklevel=2,
+        )
     if mimic:
         warnings.warn(f"{name}: mimic joints loaded as independent joints: {mimic}", RobodynWarning, stacklevel=2)
     ignored_dyn = {k: v for k, v in ignored.items() if k not in _LINK_IGNORED}
@@ -238,7 +163,7 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 
 
-def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
+def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list) -> None:
     where = rd.where(elem)
     for child in elem:
         if isinstance(child.tag, str) and child.tag not in _JOINT_READ:
@@ -249,11 +174,10 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
         raise ModelError(f"{where}: joint without a name")
     if jtype is None:
         raise ModelError(f"{where}: joint without a type")
-    if jtype in ("floating", "planar"):
-        raise ModelError(
-            f"{where}: joint type {jtype!r} is not supported inside a URDF tree; "
-            "use load_urdf(..., floating_base=True) for a free-flying root"
-        )
+    if jtype == "planar":
+        raise ModelError(f"{where}: joint type 'planar' is not supported yet")
+    if jtype == "floating":
+        jtype = "free"  # the builder checks that its parent link is welded to the world
     parent = rd.required_child(elem, "parent", "link")
     child = rd.required_child(elem, "child", "link")
     xyz, rpy = rd.origin(elem)
@@ -266,6 +190,9 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
         # without a <limit> element robodyn leaves the joint unbounded.
         for key in ("lower", "upper"):
             kw[key] = rd.floats(lim, key, 1, (0.0,))[0]
+        if kw["lower"] > kw["upper"] and jtype != "continuous":
+            # PyBullet reads such a limit as no limit; robodyn does too, and says so
+            reversed_limits.append(f"{jname} ({kw.pop('lower'):g} > {kw.pop('upper'):g})")
         for key in ("velocity", "effort"):
             if lim.get(key) is not None:
                 kw[key] = rd.floats(lim, key, 1)[0]

@@ -1,0 +1,188 @@
+"""Safe XML reading shared by the URDF and MJCF loaders.
+
+Parsing forbids DTDs, entities and external references (defusedxml), bounds the nesting
+depth and the size of the input, and records the line of every element so that every error
+can name where it is. A byte-order mark or whitespace before ``<?xml ...?>`` is accepted, as
+the major loaders accept it.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+from defusedxml import DefusedXmlException, DTDForbidden
+from defusedxml.ElementTree import DefusedXMLParser, ParseError
+
+from ..errors import ModelError
+
+MAX_DEPTH = 64
+
+
+class LineParser(DefusedXMLParser):
+    """DefusedXMLParser that records the line of every element and bounds the nesting."""
+
+    def __init__(self):
+        super().__init__(forbid_dtd=True, forbid_entities=True, forbid_external=True)
+        self.lines: dict[int, int] = {}
+        self._depth = 0
+
+    def _start(self, tag, attr_list):
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise ModelError(
+                f"<{tag}> (line {self.parser.CurrentLineNumber}): elements nested deeper than {MAX_DEPTH} levels"
+            )
+        elem = super()._start(tag, attr_list)
+        self.lines[id(elem)] = self.parser.CurrentLineNumber
+        return elem
+
+    def _end(self, tag):
+        self._depth -= 1
+        return super()._end(tag)
+
+
+def is_xml_text(source) -> bool:
+    """True when ``source`` is XML text rather than a path (its first character is ``<``)."""
+    return isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")
+
+
+def read_source(source, kind: str, max_bytes: int) -> tuple[str, str]:
+    """``(xml_text, name)`` from a path or an XML string; ``kind`` ("URDF", "MJCF") names
+    the format in errors. The text has a leading byte-order mark and whitespace removed."""
+    if isinstance(source, str) and not source.strip():
+        raise ModelError(f"<string>: empty input: expected a {kind} path or XML text")
+    if isinstance(source, (str, os.PathLike)) and not is_xml_text(source):
+        path = Path(source)
+        try:
+            is_file = path.is_file()
+            size = path.stat().st_size if is_file else 0
+        except (OSError, ValueError) as e:
+            raise ModelError(f"{path}: cannot read {kind} file ({getattr(e, 'strerror', None) or e})") from None
+        if not is_file:
+            reason = "not a regular file" if path.exists() else "no such file"
+            raise ModelError(f"{path}: cannot read {kind} file ({reason})")
+        if size > max_bytes:
+            raise ModelError(f"{path}: file of {size} bytes exceeds the limit of {max_bytes} bytes")
+        try:
+            text = path.read_bytes().decode("utf-8")
+        except OSError as e:
+            raise ModelError(f"{path}: cannot read {kind} file ({e.strerror or e})") from None
+        except UnicodeDecodeError as e:
+            raise ModelError(f"{path}: not UTF-8 text ({e})") from None
+        return _strip_lead(text), str(path)
+    if isinstance(source, bytes):
+        source = source.decode("utf-8", errors="strict")
+    if not isinstance(source, str):
+        raise TypeError(f"expected a {kind} path or an XML string, got {type(source).__name__}")
+    if len(source) > max_bytes:
+        raise ModelError(f"<string>: XML of {len(source)} characters exceeds the limit of {max_bytes}")
+    return _strip_lead(source), "<string>"
+
+
+def _strip_lead(text: str) -> str:
+    """Drop a byte-order mark, and blank out an XML declaration preceded by whitespace (expat
+    accepts a declaration only at the very start; the text is already decoded). Line numbers
+    are kept."""
+    body = text.lstrip("\ufeff")
+    lead = len(body) - len(body.lstrip(" \t\r\n"))
+    if lead and body.startswith("<?xml", lead):
+        end = body.find("?>", lead)
+        if end > 0:
+            body = body[:lead] + " " * (end + 2 - lead) + body[end + 2:]
+    return body
+
+
+def source_line(text: str, line) -> str:
+    """The stripped text of a 1-based line (shortened), to show where the XML breaks."""
+    lines = text.splitlines()
+    if not isinstance(line, int) or not 1 <= line <= len(lines):
+        return ""
+    snippet = lines[line - 1].strip()
+    return f": {snippet[:80] + ('...' if len(snippet) > 80 else '')!r}"
+
+
+def parse(text: str, name: str):
+    """``(root element, {id(element): line})``; every failure is a :class:`ModelError`.
+
+    Namespaces: elements in the root element's namespace (a default ``xmlns`` on ``<robot>``)
+    lose it (``joint``), elements of other namespaces keep it (``{uri}joint``, extension
+    elements such as ``<drake:joint>``, which loaders ignore). A prefix used without its
+    ``xmlns:prefix`` declaration, which major loaders accept, is declared as
+    ``urn:undeclared:prefix``.
+    """
+    try:
+        root, lines = _parse(text, name)
+    except _UnboundPrefix:
+        try:
+            root, lines = _parse(_declare_prefixes(text), name)
+        except _UnboundPrefix:
+            raise ModelError(f"{name}: malformed XML (a namespace prefix that cannot be declared)") from None
+    _strip_default_namespace(root)
+    return root, lines
+
+
+class _UnboundPrefix(Exception):
+    pass
+
+
+_PREFIX = re.compile(r"<\s*/?\s*([A-Za-z_][\w.-]*):|\s([A-Za-z_][\w.-]*):[A-Za-z_][\w.-]*\s*=")
+_ROOT_START = re.compile(r"<\s*(?![?!])[^\s/>]+")
+
+
+def _declare_prefixes(text: str) -> str:
+    """``text`` with every used, undeclared namespace prefix declared on the root element (on
+    the root's own line, so line numbers hold)."""
+    used = {m.group(1) or m.group(2) for m in _PREFIX.finditer(text)} - {"xml", "xmlns"}
+    declared = set(re.findall(r"xmlns:([A-Za-z_][\w.-]*)\s*=", text))
+    missing = sorted(used - declared)
+    m = _ROOT_START.search(text)
+    if not missing or m is None:
+        return text
+    decl = "".join(f' xmlns:{p}="urn:undeclared:{p}"' for p in missing)
+    return text[: m.end()] + decl + text[m.end():]
+
+
+def _strip_default_namespace(root) -> None:
+    if not (isinstance(root.tag, str) and root.tag.startswith("{")):
+        return
+    prefix = root.tag[: root.tag.index("}") + 1]
+    for elem in root.iter():
+        if isinstance(elem.tag, str) and elem.tag.startswith(prefix):
+            elem.tag = elem.tag[len(prefix):]
+
+
+def _parse(text: str, name: str):
+    parser = LineParser()
+    try:
+        parser.feed(text)
+        root = parser.close()
+    except ParseError as e:
+        if "unbound prefix" in str(e):
+            raise _UnboundPrefix() from None
+        line = e.position[0] if getattr(e, "position", None) else "?"
+        raise ModelError(f"{name}: line {line}{source_line(text, line)}: malformed XML ({e})") from None
+    except DefusedXmlException as e:
+        line = parser.parser.CurrentLineNumber
+        if isinstance(e, DTDForbidden):
+            what = f"<!DOCTYPE {e.name}>"
+        else:
+            what = f"<!ENTITY {e.name}>" if hasattr(e, "name") else "external reference"
+        raise ModelError(
+            f"{name}: {what} (line {line}): forbidden XML construct ({type(e).__name__}); "
+            "DTDs and entities are not allowed"
+        ) from None
+    except ModelError as e:
+        raise ModelError(f"{name}: {e}") from None
+    except RecursionError:
+        raise ModelError(f"{name}: XML nested too deeply") from None
+    return root, parser.lines
+
+
+def local_name(tag) -> str | None:
+    """The tag without an XML namespace (``{uri}joint`` -> ``joint``); None for comments and
+    processing instructions."""
+    if not isinstance(tag, str):
+        return None
+    return tag.rsplit("}", 1)[-1] if tag.startswith("{") else tag
