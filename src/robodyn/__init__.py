@@ -8,7 +8,7 @@
 """
 
 from .builder import ModelBuilder
-from .io import DHLink, dh_transform, from_dh, load_urdf, write_urdf
+from .io import DHLink, dh_transform, from_dh, load_mjcf, load_urdf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
@@ -66,7 +66,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh",
-    "load_urdf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
+    "load_urdf", "load_mjcf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",

@@ -1,0 +1,645 @@
+"""MJCF (MuJoCo XML) loader: ``load_mjcf(path_or_xml_string) -> Model``.
+
+Reads what a robot description uses, with MuJoCo's own rules (its compiler, ``user_objects.cc``):
+
+- ``<worldbody>`` body trees; ``<frame>`` elements compose into their children. A body's pose
+  is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (``<compiler eulerseq>``:
+  lower case axes rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; angles
+  in ``<compiler angle>`` units (degrees unless ``radian``).
+- joints ``hinge``, ``slide`` and ``free`` (``<freejoint>`` too), with ``pos``, ``axis``,
+  ``ref``, ``range`` (``limited`` true/false/auto with ``<compiler autolimits>``),
+  ``armature``, ``damping`` and ``frictionloss`` (Coulomb friction). Several joints in one
+  body become a chain of massless bodies named ``body:joint``, the last one named after the
+  body; MuJoCo applies them in order, each about its anchor ``pos`` in the frame the earlier
+  ones have moved. ``ref`` is folded into the joint placement, so ``q`` is MuJoCo's ``qpos``
+  exactly (for free joints up to the quaternion order, see :mod:`robodyn.interop.mujoco`).
+  A body without joints is welded to its parent (merged, as URDF fixed joints are).
+- ``<inertial>`` (``mass``, ``pos``, ``diaginertia`` with an orientation, or ``fullinertia``),
+  or, when it is absent (``<compiler inertiafromgeom="auto">``, the default; ``true`` and
+  ``false`` as MuJoCo), the inertia of the body's geoms in ``<compiler inertiagrouprange>``:
+  spheres, capsules, cylinders, boxes and ellipsoids of uniform ``density`` (1000 unless
+  given) or of a given ``mass``, ``size`` or ``fromto``; then ``boundmass``,
+  ``boundinertia``, ``balanceinertia`` and ``settotalmass`` as MuJoCo applies them.
+- ``<default>`` classes with inheritance (``class``, ``childclass``), ``<include file>``
+  (relative to the main file's folder), ``<option gravity>`` and its gravity flag, named
+  ``<site>`` elements as frames (``site:name`` where a body already has the name).
+
+Refused with a :class:`~robodyn.model.ModelError` naming the file, element and line: ball
+joints (the spherical joint type is not in robodyn yet), inertia from mesh, height-field or
+SDF geoms (give the body an ``<inertial>``), shell inertia, elements that generate bodies
+(``<composite>``, ``<flexcomp>``, ``<replicate>``, ``<attach>``), global coordinates, a free
+joint below a moving body. Ignored with one :class:`~robodyn.errors.RobodynWarning` listing
+them: elements that are not the rigid-body dynamics of the tree (actuators, tendons,
+equality constraints, sensors, contact pairs, ...), joint springs (``stiffness``) and
+gravity compensation (``gravcomp``). Visual elements (assets, cameras, lights) are skipped
+silently. Contacts are not part of the model.
+
+The XML is read as the URDF loader reads it: DTDs, entities and external references
+forbidden, size and depth bounded, at most ``MAX_INCLUDES`` included files.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections import Counter
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..builder import ModelBuilder
+from ..errors import ModelError, RobodynWarning
+from ..lie import quat_matrix
+from ..model import Model
+from ._xml import is_xml_text, parse, read_source
+
+__all__ = ["MAX_FILE_BYTES", "MAX_INCLUDES", "load_mjcf"]
+
+MAX_FILE_BYTES = 64 * 1024 * 1024
+MAX_INCLUDES = 100
+
+# Elements read, or skipped silently because they draw or store things (no dynamics).
+_TOP_READ = {"compiler", "option", "default", "worldbody", "include"}
+_TOP_SILENT = {"asset", "visual", "statistic", "size", "custom", "extension", "keyframe"}
+_BODY_READ = {"body", "joint", "freejoint", "geom", "site", "inertial", "frame"}
+_BODY_SILENT = {"camera", "light", "plugin"}
+_GENERATORS = {"composite", "flexcomp", "replicate", "attach"}
+_ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
+_EPS = 1e-14  # mjEPS
+
+
+@dataclass
+class _Compiler:
+    degree: bool = True
+    eulerseq: str = "xyz"
+    autolimits: bool = True
+    inertiafromgeom: str = "auto"
+    inertiagrouprange: tuple = (0, 5)
+    boundmass: float = 0.0
+    boundinertia: float = 0.0
+    balanceinertia: bool = False
+    settotalmass: float = -1.0
+    alignfree: bool = False
+
+
+class _Doc:
+    """Where each element comes from (file and line), and the reading helpers."""
+
+    def __init__(self, name: str, lines: dict[int, int]):
+        self.name = name
+        self.lines = lines
+        self.files: dict[int, str] = {}
+        self.included_bytes = 0
+        self.includes = 0
+
+    def where(self, elem) -> str:
+        label = f"<{elem.tag}" + (f" name={elem.get('name')!r}" if elem.get("name") is not None else "") + ">"
+        return f"{self.files.get(id(elem), self.name)}: {label} (line {self.lines.get(id(elem), '?')})"
+
+    def floats(self, elem, attrs: dict, key: str, n, default=None) -> np.ndarray:
+        """``n`` numbers (an int, or a (min, max) range of counts) of attribute ``key``."""
+        raw = attrs.get(key)
+        if raw is None:
+            if default is None:
+                raise ModelError(f"{self.where(elem)}: missing attribute {key!r}")
+            return np.asarray(default, dtype=float)
+        lo, hi = (n, n) if isinstance(n, int) else n
+        try:
+            vals = np.array([float(t) for t in raw.split()], dtype=float)
+        except ValueError:
+            raise ModelError(f"{self.where(elem)}: attribute {key}={raw!r} is not a list of numbers") from None
+        if not lo <= vals.size <= hi:
+            count = f"{lo}" if lo == hi else f"{lo} to {hi}"
+            raise ModelError(f"{self.where(elem)}: attribute {key}={raw!r} needs {count} number(s)")
+        if not np.all(np.isfinite(vals)):
+            raise ModelError(f"{self.where(elem)}: attribute {key}={raw!r} is not finite")
+        return vals
+
+    def number(self, elem, attrs, key, default) -> float:
+        return float(self.floats(elem, attrs, key, 1, None if default is None else (default,))[0])
+
+    def flag(self, elem, attrs, key, default, choices=("true", "false")) -> str:
+        raw = attrs.get(key, default)
+        if raw not in choices:
+            raise ModelError(f"{self.where(elem)}: attribute {key}={raw!r} must be one of {list(choices)}")
+        return raw
+
+
+def load_mjcf(source, *, physical: str = "error") -> Model:
+    """Load an MJCF file (path) or XML string into a :class:`Model` (rules in the module
+    docstring). Every body tree of ``<worldbody>`` hangs from the fixed world; bodies with a
+    free joint are floating bases. ``physical`` as in :func:`~robodyn.io.urdf.load_urdf`.
+    The order of bodies and of ``v`` is MuJoCo's (depth first, in file order)."""
+    text, name = read_source(source, "MJCF", MAX_FILE_BYTES)
+    root, lines = parse(text, name)
+    doc = _Doc(name, lines)
+    if root.tag != "mujoco":
+        raise ModelError(f"{doc.where(root)}: root element must be <mujoco>, got <{root.tag}>")
+    base = None if is_xml_text(source) or isinstance(source, bytes) else Path(name).parent
+    _expand_includes(root, doc, base, [name])
+    compiler = _read_compiler(root, doc)
+    gravity = _read_gravity(root, doc)
+    defaults = _read_defaults(root, doc)
+    ignored: Counter[str] = Counter()
+    for elem in root:
+        if isinstance(elem.tag, str) and elem.tag not in _TOP_READ | _TOP_SILENT:
+            ignored[elem.tag] += 1
+    reader = _Bodies(doc, compiler, defaults, ignored)
+    for world in root.findall("worldbody"):
+        reader.children(world, "world", (np.eye(3), np.zeros(3)), "main", world=True)
+    b = ModelBuilder(root.get("model", "mujoco"), gravity=gravity, source=name, physical=physical)
+    reader.build(b)
+    notes = []
+    if ignored:
+        notes.append("ignored elements that are not the rigid-body dynamics of the tree: "
+                     + ", ".join(f"{n} <{k}>" for k, n in sorted(ignored.items())))
+    for what, names in reader.unmodelled.items():
+        if names:
+            notes.append(f"{what} not modelled: {names}")
+    if notes:
+        warnings.warn(f"{name}: " + "; ".join(notes), RobodynWarning, stacklevel=2)
+    return b.build()
+
+
+# --------------------------------------------------------------------------------------------
+# document level: includes, compiler, option, defaults
+# --------------------------------------------------------------------------------------------
+
+def _expand_includes(elem, doc: _Doc, base: Path | None, stack: list[str]) -> None:
+    """Replace every ``<include file>`` below ``elem`` by the children of the included
+    ``<mujoco>`` (recursively), with cycles, count and total size bounded."""
+    for k, child in enumerate(list(elem)):
+        if child.tag != "include":
+            if isinstance(child.tag, str):
+                _expand_includes(child, doc, base, stack)
+            continue
+        where = doc.where(child)
+        file = child.get("file")
+        if not file:
+            raise ModelError(f"{where}: missing attribute 'file'")
+        if base is None:
+            raise ModelError(f"{where}: <include> in XML text: load the model from its file")
+        path = base / file
+        if str(path) in stack:
+            raise ModelError(f"{where}: {path} includes itself (through {' -> '.join(stack)})")
+        doc.includes += 1
+        if doc.includes > MAX_INCLUDES:
+            raise ModelError(f"{where}: more than {MAX_INCLUDES} included files")
+        text, name = read_source(path, "MJCF", MAX_FILE_BYTES - doc.included_bytes)
+        doc.included_bytes += len(text)
+        sub, lines = parse(text, name)
+        if sub.tag != "mujoco":
+            raise ModelError(f"{name}: root element of an included file must be <mujoco>, got <{sub.tag}>")
+        doc.lines.update(lines)
+        for e in sub.iter():
+            doc.files[id(e)] = name
+        _expand_includes(sub, doc, base, stack + [str(path)])
+        elem.remove(child)
+        for j, inc in enumerate(list(sub)):
+            elem.insert(k + j, inc)
+    # children inserted above were expanded inside their own file
+
+
+def _read_compiler(root, doc: _Doc) -> _Compiler:
+    c = _Compiler()
+    for e in root.findall("compiler"):
+        a = e.attrib
+        if "coordinate" in a and a["coordinate"] != "local":
+            raise ModelError(f"{doc.where(e)}: coordinate={a['coordinate']!r}: only local coordinates are supported")
+        if "angle" in a:
+            c.degree = doc.flag(e, a, "angle", "degree", ("degree", "radian")) == "degree"
+        if "eulerseq" in a:
+            seq = a["eulerseq"]
+            if len(seq) != 3 or any(ch not in "xyzXYZ" for ch in seq):
+                raise ModelError(f"{doc.where(e)}: eulerseq={seq!r} must be 3 letters of x, y, z, X, Y, Z")
+            c.eulerseq = seq
+        for key in ("autolimits", "balanceinertia", "alignfree"):
+            if key in a:
+                setattr(c, key, doc.flag(e, a, key, "false") == "true")
+        if "inertiafromgeom" in a:
+            c.inertiafromgeom = doc.flag(e, a, "inertiafromgeom", "auto", ("auto", "true", "false"))
+        if "inertiagrouprange" in a:
+            g = doc.floats(e, a, "inertiagrouprange", 2)
+            c.inertiagrouprange = (int(g[0]), int(g[1]))
+        for key in ("boundmass", "boundinertia", "settotalmass"):
+            if key in a:
+                setattr(c, key, doc.number(e, a, key, 0.0))
+    return c
+
+
+def _read_gravity(root, doc: _Doc) -> np.ndarray:
+    g = np.array([0.0, 0.0, -9.81])
+    for e in root.findall("option"):
+        if "gravity" in e.attrib:
+            g = doc.floats(e, e.attrib, "gravity", 3)
+        for f in e.findall("flag"):
+            if f.get("gravity") == "disable":
+                g = np.zeros(3)
+    return g
+
+
+def _read_defaults(root, doc: _Doc) -> dict[str, dict[str, dict[str, str]]]:
+    """``{class: {element tag: attributes}}`` with inheritance resolved; the top class is "main"."""
+    out: dict[str, dict[str, dict[str, str]]] = {"main": {}}
+
+    def visit(elem, name, inherited):
+        own = {t: dict(v) for t, v in inherited.items()}
+        for child in elem:
+            if isinstance(child.tag, str) and child.tag != "default":
+                own[child.tag] = _override(own.get(child.tag, {}), child.attrib)
+        out[name] = own
+        for child in elem.findall("default"):
+            cls = child.get("class")
+            if cls is None:
+                raise ModelError(f"{doc.where(child)}: a nested <default> needs a class")
+            if cls in out:
+                raise ModelError(f"{doc.where(child)}: default class {cls!r} defined twice")
+            visit(child, cls, own)
+
+    for top in root.findall("default"):
+        visit(top, top.get("class", "main"), out["main"])
+    return out
+
+
+def _override(base: dict, own) -> dict:
+    """Attributes ``own`` over defaults ``base``, as MuJoCo applies them: an explicit
+    orientation replaces the default's, and a ``size`` of fewer numbers keeps the default's
+    others."""
+    merged = dict(base)
+    if any(k in own for k in _ORIENTATIONS):
+        for k in _ORIENTATIONS:
+            merged.pop(k, None)
+    own = dict(own)
+    if "size" in own and "size" in merged:
+        d, e = merged["size"].split(), own.pop("size").split()
+        merged["size"] = " ".join(e + d[len(e):])
+    merged.update(own)
+    return merged
+
+
+# --------------------------------------------------------------------------------------------
+# the body tree
+# --------------------------------------------------------------------------------------------
+
+@dataclass
+class _Link:
+    name: str
+    mass: float = 0.0
+    com: np.ndarray = None
+    inertia: np.ndarray = None  # about the centre of mass, link axes
+    where: str = ""
+
+
+def _compose(a, b):
+    """Pose ``a * b`` of (R, p) pairs."""
+    return a[0] @ b[0], a[1] + a[0] @ b[1]
+
+
+def _axis_rotation(axis, angle) -> np.ndarray:
+    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
+
+
+def _quat(w, x, y, z) -> np.ndarray:
+    return np.array([w, x, y, z], dtype=float)
+
+
+def _quat_mul(a, b) -> np.ndarray:
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return _quat(w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+                 w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)
+
+
+def _z_to(vec) -> np.ndarray:
+    """Rotation taking the z axis to the unit vector ``vec`` by the shortest arc (mjuu_z2quat)."""
+    axis = np.cross([0.0, 0.0, 1.0], vec)
+    s = np.linalg.norm(axis)
+    axis = np.array([1.0, 0.0, 0.0]) if s < 1e-10 else axis / s
+    return _axis_rotation(axis, np.arctan2(s, vec[2]))
+
+
+class _Bodies:
+    """Walks the body tree, collecting links (with their inertia), joints and frames."""
+
+    def __init__(self, doc: _Doc, compiler: _Compiler, defaults, ignored: Counter):
+        self.doc, self.c, self.defaults, self.ignored = doc, compiler, defaults, ignored
+        self.links: list[_Link] = [_Link("world", where=f"{doc.name}: <worldbody>")]
+        self.joints: list[tuple] = []  # (name, type, parent, child, xyz, R, axis, limits, where)
+        self.sites: list[tuple] = []
+        self.unmodelled = {"joint springs (stiffness)": [], "gravity compensation (gravcomp)": []}
+        self.nbody = 0
+        self.njoint = 0
+
+    # attributes with defaults -----------------------------------------------------------
+    def attrs(self, elem, cls: str) -> dict:
+        cls = elem.get("class", cls)
+        if cls not in self.defaults:
+            raise ModelError(f"{self.doc.where(elem)}: unknown default class {cls!r}")
+        return _override(self.defaults[cls].get(elem.tag, {}), elem.attrib)
+
+    def rotation(self, elem, a) -> np.ndarray:
+        doc, given = self.doc, [k for k in _ORIENTATIONS if k in a]
+        if len(given) > 1:
+            raise ModelError(f"{doc.where(elem)}: several orientations given ({', '.join(given)})")
+        if not given:
+            return np.eye(3)
+        kind = given[0]
+        unit = np.pi / 180 if self.c.degree else 1.0
+        if kind == "quat":
+            q = doc.floats(elem, a, "quat", 4)
+            n = np.linalg.norm(q)
+            if n < _EPS:
+                raise ModelError(f"{doc.where(elem)}: quat is zero")
+            return quat_matrix(np.r_[q[1:], q[0]] / n)
+        if kind == "axisangle":
+            v = doc.floats(elem, a, "axisangle", 4)
+            n = np.linalg.norm(v[:3])
+            if n < _EPS:
+                raise ModelError(f"{doc.where(elem)}: axisangle axis is zero")
+            return _axis_rotation(v[:3] / n, v[3] * unit)
+        if kind == "euler":
+            e = doc.floats(elem, a, "euler", 3) * unit
+            q = _quat(1, 0, 0, 0)
+            for ch, angle in zip(self.c.eulerseq, e):
+                r = _quat(np.cos(angle / 2), 0, 0, 0)
+                r["xyz".index(ch.lower()) + 1] = np.sin(angle / 2)
+                q = _quat_mul(q, r) if ch.islower() else _quat_mul(r, q)
+            return quat_matrix(np.r_[q[1:], q[0]] / np.linalg.norm(q))
+        if kind == "xyaxes":
+            v = doc.floats(elem, a, "xyaxes", 6)
+            x, y = v[:3], v[3:]
+            if np.linalg.norm(x) < _EPS:
+                raise ModelError(f"{doc.where(elem)}: xyaxes: x axis is zero")
+            x = x / np.linalg.norm(x)
+            y = y - x * (x @ y)
+            if np.linalg.norm(y) < _EPS:
+                raise ModelError(f"{doc.where(elem)}: xyaxes: y axis is parallel to x")
+            y = y / np.linalg.norm(y)
+            return np.column_stack([x, y, np.cross(x, y)])
+        z = doc.floats(elem, a, "zaxis", 3)
+        if np.linalg.norm(z) < _EPS:
+            raise ModelError(f"{doc.where(elem)}: zaxis is zero")
+        return _z_to(z / np.linalg.norm(z))
+
+    def pose(self, elem, a):
+        """The frame of ``elem`` in its parent's frame (``fromto`` for geoms and sites)."""
+        if "fromto" in a and elem.tag in ("geom", "site"):
+            return self.fromto(elem, a)[0]
+        return self.rotation(elem, a), self.doc.floats(elem, a, "pos", 3, (0.0, 0.0, 0.0))
+
+    def fromto(self, elem, a):
+        """``((R, p), half length)`` of a ``fromto`` segment: centred, z from the end to the start."""
+        ft = self.doc.floats(elem, a, "fromto", 6)
+        vec = ft[:3] - ft[3:]
+        half = np.linalg.norm(vec) / 2
+        if half < _EPS:
+            raise ModelError(f"{self.doc.where(elem)}: fromto points too close")
+        return (_z_to(vec / (2 * half)), (ft[:3] + ft[3:]) / 2), half
+
+    # the tree -----------------------------------------------------------------------------
+    def children(self, elem, link: str, pre, cls: str, world: bool = False) -> None:
+        """Read the children of a body (or frame) ``elem``, whose frame sits at ``pre`` in
+        ``link``'s frame; ``world`` when ``link`` is welded to the world."""
+        for child in elem:
+            tag = child.tag
+            if not isinstance(tag, str) or tag in ("joint", "freejoint", "inertial", "geom"):
+                continue  # read with their body
+            if tag == "body":
+                self.body(child, link, pre, cls, world)
+            elif tag == "frame":
+                a = self.attrs(child, cls)
+                self.children(child, link, _compose(pre, self.pose(child, a)), child.get("childclass", cls), world)
+            elif tag == "site":
+                name = child.get("name")
+                if name:
+                    self.sites.append((name, link, _compose(pre, self.pose(child, self.attrs(child, cls))),
+                                       self.doc.where(child)))
+            elif tag in _GENERATORS:
+                raise ModelError(f"{self.doc.where(child)}: <{tag}> (generated bodies) is not supported")
+            elif tag not in _BODY_SILENT:
+                self.ignored[tag] += 1
+
+    def body(self, elem, parent: str, pre, cls: str, world: bool) -> None:
+        doc = self.doc
+        self.nbody += 1
+        name = elem.get("name") or f"body{self.nbody}"
+        cls = elem.get("childclass", cls)
+        a = dict(elem.attrib)
+        if float(a.get("gravcomp", 0) or 0) != 0:
+            self.unmodelled["gravity compensation (gravcomp)"].append(name)
+        frame = _compose(pre, self.pose(elem, a))  # the body frame in the parent link's frame
+        joints = [j for j in elem if j.tag in ("joint", "freejoint")]
+        link, types = parent, []
+        for k, j in enumerate(joints):
+            ja = self.attrs(j, cls) if j.tag == "joint" else dict(j.attrib, type="free")
+            types.append(ja.get("type", "hinge"))
+            self.njoint += 1
+            jname = ja.get("name") or f"joint{self.njoint}"
+            jtype = ja.get("type", "hinge")
+            where = doc.where(j)
+            if jtype == "ball":
+                raise ModelError(f"{where}: ball joints are not supported yet (no spherical joint type)")
+            if jtype not in ("hinge", "slide", "free"):
+                raise ModelError(f"{where}: unknown joint type {jtype!r}")
+            child = name if k == len(joints) - 1 else f"{name}:{jname}"
+            if jtype == "free":
+                if len(joints) > 1:
+                    raise ModelError(f"{where}: a free joint must be the only joint of its body")
+                if not world:
+                    raise ModelError(f"{where}: a free joint must be in a body whose parent is the world")
+                self.links.append(_Link(child, where=doc.where(elem)))
+                self.joints.append((jname, "free", link, child, np.zeros(3), np.eye(3), np.zeros(3),
+                                    self.joint_options(j, ja, jtype), where))
+                frame = (np.eye(3), np.zeros(3))
+            else:
+                axis = doc.floats(j, ja, "axis", 3, (0.0, 0.0, 1.0))
+                if np.linalg.norm(axis) < _EPS:
+                    raise ModelError(f"{where}: joint axis is zero")
+                axis = axis / np.linalg.norm(axis)
+                anchor = doc.floats(j, ja, "pos", 3, (0.0, 0.0, 0.0))
+                ref = doc.number(j, ja, "ref", 0.0) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
+                if jtype == "hinge":  # F Trans(p) Rot(a, q - ref) = [F Trans(p) Rot(a, -ref)] Rot(a, q)
+                    place = _compose(frame, (_axis_rotation(axis, -ref), anchor))
+                else:  # F Trans(p + a (q - ref)) = [F Trans(p - a ref)] Trans(a q)
+                    place = _compose(frame, (np.eye(3), anchor - axis * ref))
+                self.links.append(_Link(child, where=doc.where(elem)))
+                self.joints.append((jname, "revolute" if jtype == "hinge" else "prismatic", link, child,
+                                    place[1], place[0], axis, self.joint_options(j, ja, jtype), where))
+                frame = (np.eye(3), -anchor)  # the body frame in the new link's frame
+            if float(ja.get("stiffness", 0) or 0) != 0:
+                self.unmodelled["joint springs (stiffness)"].append(jname)
+            link = child
+        if not joints:  # welded to the parent
+            self.links.append(_Link(name, where=doc.where(elem)))
+            self.joints.append((f"{name}:weld", "fixed", parent, name, frame[1], frame[0], np.zeros(3), {},
+                                doc.where(elem)))
+            link, frame = name, (np.eye(3), np.zeros(3))
+        self.inertia(elem, cls, self.links[-1], frame, any(t == "free" for t in types))
+        self.children(elem, link, frame, cls, world and not joints)
+
+    def joint_options(self, elem, a, jtype: str) -> dict:
+        doc = self.doc
+        out = {}
+        for key, field in (("armature", "armature"), ("damping", "damping"), ("frictionloss", "friction")):
+            out[field] = doc.number(elem, a, key, 0.0)
+        if jtype == "free":
+            return out
+        limited = doc.flag(elem, a, "limited", "auto", ("true", "false", "auto"))
+        if limited == "true" or (limited == "auto" and self.c.autolimits and "range" in a):
+            lo, hi = doc.floats(elem, a, "range", 2, (0.0, 0.0)) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
+            if lo >= hi:
+                raise ModelError(f"{doc.where(elem)}: range {a.get('range')!r} must have min < max")
+            out["lower"], out["upper"] = lo, hi
+        return out
+
+    # inertia ----------------------------------------------------------------------------------
+    def inertia(self, elem, cls: str, link: _Link, frame, free: bool) -> None:
+        """Mass, centre of mass and inertia (about the centre of mass) of the MuJoCo body
+        ``elem`` in ``link``'s frame (the body frame sits at ``frame`` in it)."""
+        doc, c = self.doc, self.c
+        inertials = elem.findall("inertial")
+        if len(inertials) > 1:
+            raise ModelError(f"{doc.where(inertials[1])}: more than one <inertial>")
+        mass, pos, I = 0.0, np.zeros(3), np.zeros((3, 3))
+        if inertials:
+            e = inertials[0]
+            a = e.attrib
+            mass = doc.number(e, a, "mass", None)
+            pos = doc.floats(e, a, "pos", 3)
+            if "fullinertia" in a:
+                if any(k in a for k in _ORIENTATIONS) or "diaginertia" in a:
+                    raise ModelError(f"{doc.where(e)}: fullinertia excludes diaginertia and orientations")
+                f = doc.floats(e, a, "fullinertia", 6)
+                I = np.array([[f[0], f[3], f[4]], [f[3], f[1], f[5]], [f[4], f[5], f[2]]])
+            else:
+                R = self.rotation(e, a)
+                I = R @ np.diag(doc.floats(e, a, "diaginertia", 3)) @ R.T
+        if c.inertiafromgeom == "true" or (c.inertiafromgeom == "auto" and not inertials):
+            mass, pos, I = self.geom_inertia(elem, cls) or (mass, pos, I)  # no geoms: as it was
+        if mass < 0:
+            raise ModelError(f"{doc.where(elem)}: negative mass {mass}")
+        if c.boundmass > 0 or c.boundinertia > 0 or c.balanceinertia:
+            d, V = np.linalg.eigh(I)
+            mass = max(mass, c.boundmass)
+            d = np.maximum(d, c.boundinertia)
+            if c.balanceinertia and (d[0] + d[1] < d[2]):
+                d[:] = d.sum() / 3
+            I = V @ np.diag(d) @ V.T
+        if free and c.alignfree:
+            raise ModelError(f"{doc.where(elem)}: alignfree (a free body frame moved to its inertia) is not supported")
+        R, p = frame
+        link.mass, link.com, link.inertia = mass, p + R @ pos, R @ I @ R.T
+
+    def geom_inertia(self, body, cls: str):
+        """MuJoCo's inertia from geoms (``mjCGeom::SetInertia``, solid bodies): ``(mass, com,
+        inertia about the com)`` in the body frame, or None when no geom has mass."""
+        doc, lo_hi = self.doc, self.c.inertiagrouprange
+        parts = []
+
+        def collect(elem, pre, cls):
+            for g in elem:
+                if g.tag == "frame":
+                    a = self.attrs(g, cls)
+                    collect(g, _compose(pre, self.pose(g, a)), g.get("childclass", cls))
+                elif g.tag == "geom":
+                    a = self.attrs(g, cls)
+                    group = int(doc.number(g, a, "group", 0))
+                    if lo_hi[0] <= group <= lo_hi[1]:
+                        part = self.geom(g, a)
+                        if part is not None:
+                            parts.append((part[0], _compose(pre, part[1]), part[2]))
+
+        collect(body, (np.eye(3), np.zeros(3)), cls)
+        parts = [p for p in parts if p[0] > _EPS]
+        if not parts:
+            return None
+        mass = sum(p[0] for p in parts)
+        com = sum(m * pose[1] for m, pose, _ in parts) / mass
+        I = np.zeros((3, 3))
+        for m, (R, p), d in parts:
+            r = p - com
+            I += R @ np.diag(d) @ R.T + m * (r @ r * np.eye(3) - np.outer(r, r))
+        return mass, com, I
+
+    def geom(self, g, a):
+        """``(mass, (R, p), principal moments)`` of one geom in its body's frame, or None."""
+        doc = self.doc
+        gtype = a.get("type", "sphere")
+        where = doc.where(g)
+        if gtype in ("mesh", "sdf", "hfield") or ("mesh" in a and gtype != "plane"):
+            raise ModelError(f"{where}: inertia from a {gtype} geom is not supported; give the body an <inertial>")
+        if a.get("shellinertia", "false") == "true":
+            raise ModelError(f"{where}: shell inertia is not supported")
+        if gtype not in ("sphere", "capsule", "cylinder", "box", "ellipsoid", "plane"):
+            raise ModelError(f"{where}: unknown geom type {gtype!r}")
+        size = np.zeros(3)
+        given = doc.floats(g, a, "size", (1, 3), (0.0,))
+        size[: given.size] = given
+        if "fromto" in a:
+            if gtype not in ("capsule", "cylinder", "ellipsoid", "box"):
+                raise ModelError(f"{where}: fromto needs a capsule, cylinder, box or ellipsoid")
+            pose, half = self.fromto(g, a)
+            if gtype in ("ellipsoid", "box"):
+                size[2], size[1] = half, size[0]
+            else:
+                size[1] = half
+        else:
+            pose = self.pose(g, a)
+        r, h = size[0], 2 * size[1]
+        volume = {
+            "sphere": 4 * np.pi * r ** 3 / 3,
+            "capsule": np.pi * (r * r * h + 4 * r ** 3 / 3),
+            "cylinder": np.pi * r * r * h,
+            "ellipsoid": 4 * np.pi * size[0] * size[1] * size[2] / 3,
+            "box": 8 * size[0] * size[1] * size[2],
+            "plane": 0.0,
+        }[gtype]
+        if "mass" in a:
+            mass = doc.number(g, a, "mass", 0.0)
+            if mass != 0 and volume <= _EPS:
+                return None
+        else:
+            mass = doc.number(g, a, "density", 1000.0) * volume
+        if mass < 0:
+            raise ModelError(f"{where}: negative mass or density")
+        if mass == 0:
+            return None
+        s = size * size
+        if gtype == "sphere":
+            d = np.full(3, 2 * mass * r * r / 5)
+        elif gtype == "capsule":
+            ms = mass * 4 * r / (4 * r + 3 * h)  # the two hemispheres
+            mc = mass - ms
+            axial = mc * (3 * r * r + h * h) / 12 + 2 * ms * r * r / 5 + ms * h * (3 * r + 2 * h) / 8
+            d = np.array([axial, axial, mc * r * r / 2 + 2 * ms * r * r / 5])
+        elif gtype == "cylinder":
+            axial = mass * (3 * r * r + h * h) / 12
+            d = np.array([axial, axial, mass * r * r / 2])
+        elif gtype == "ellipsoid":
+            d = mass * np.array([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) / 5
+        else:
+            d = mass * np.array([s[1] + s[2], s[0] + s[2], s[0] + s[1]]) / 3
+        return mass, pose, d
+
+    # into the builder ------------------------------------------------------------------------
+    def build(self, b: ModelBuilder) -> None:
+        scale = 1.0
+        total = sum(k.mass for k in self.links[1:])
+        if self.c.settotalmass > 0 and total > 0:
+            scale = self.c.settotalmass / total
+        names = set()
+        for k in self.links:
+            names.add(k.name)
+            if k.com is None:
+                b.add_link(k.name, where=k.where)
+            else:
+                b.add_link(k.name, mass=k.mass * scale, com=k.com, inertia=k.inertia * scale, where=k.where)
+        for name, jtype, parent, child, xyz, R, axis, options, where in self.joints:
+            b.add_joint(name, jtype, parent, child, xyz=xyz, rotation=R, axis=axis if jtype != "fixed" else (1, 0, 0),
+                        where=where, **options)
+        for name, link, (R, p), where in self.sites:
+            label = name if name not in names else f"site:{name}"
+            names.add(label)
+            b.add_link(label, where=where)
+            b.add_joint(f"{label}:site", "fixed", link, label, xyz=p, rotation=R, where=where)
