@@ -48,6 +48,20 @@ def test_info_urdf(capsys, tmp_path):
     assert code == 0 and "nq=8, nv=7" in out and "root_joint" in out
 
 
+def test_info_and_demo_of_a_mujoco_model(capsys, tmp_path):
+    xml = tmp_path / "cart.xml"
+    xml.write_text('<mujoco model="cart"><worldbody><body name="cart"><joint name="slider" type="slide" '
+                   'axis="1 0 0"/><geom type="box" size="0.2 0.1 0.05"/><body name="pole"><joint name="hinge" '
+                   'axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0 0 0.6" size="0.045"/></body></body>'
+                   '</worldbody></mujoco>')
+    code, out, _ = run(capsys, "info", str(xml))
+    assert code == 0 and "Model 'cart': nq=2, nv=2" in out and "slider" in out and "hinge" in out
+    code, out, _ = run(capsys, "demo", str(xml))
+    assert code == 0
+    code, _, err = run(capsys, "info", str(xml), "--floating-base")
+    assert code == 2 and "a MuJoCo model declares its free joints" in err
+
+
 def test_demo_numbers_are_the_library_numbers(capsys):
     code, out, _ = run(capsys, "demo", "planar_2r")
     assert code == 0

@@ -13,24 +13,29 @@ from .. import models
 
 
 def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
-    """A built-in robot by name, or a URDF file by path."""
+    """A built-in robot by name, a MuJoCo model (``.xml``, ``.mjcf``) or a URDF file by path."""
+    from ..io.mjcf import load_mjcf
     from ..io.urdf import load_urdf
 
     if spec in models.names():
         if floating_base:
             raise ValueError("--floating-base applies to URDF files; built-in robots have a fixed base")
         return models.load(spec)
+    if spec.lower().endswith((".xml", ".mjcf")):
+        if floating_base:
+            raise ValueError("--floating-base applies to URDF files; a MuJoCo model declares its free joints")
+        return load_mjcf(spec, physical=physical)
     if spec.endswith(".urdf") or "/" in spec:
         return load_urdf(spec, floating_base=floating_base, physical=physical)
-    raise ValueError(f"unknown model {spec!r}: give a URDF path or one of {models.names()}")
+    raise ValueError(f"unknown model {spec!r}: give a URDF or MJCF path or one of {models.names()}")
 
 
 def add_model_arguments(p, default=None) -> None:
     """The model argument and the loader options of a command."""
-    p.add_argument("model", nargs="?", default=default, help="built-in robot name or URDF path")
+    p.add_argument("model", nargs="?", default=default, help="built-in robot name, URDF path or MJCF path (.xml)")
     p.add_argument("--floating-base", action="store_true", help="URDF: add a free-flying base")
     p.add_argument("--physical", choices=("error", "warn"), default="error",
-                   help="URDF: reject (error) or keep with a warning (warn) unphysical inertias")
+                   help="reject (error) or keep with a warning (warn) unphysical inertias")
 
 
 def check_output_file(path, option: str) -> None:
