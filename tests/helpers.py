@@ -28,15 +28,23 @@ from robodyn.random import random_model, random_state
 
 G = 9.81
 
-# (bodies, seed, floating base, branching): chains, branches, 1..15 bodies, both base types
+# (bodies, seed, floating base, branching, joint types): chains, branches, 1..15 bodies, both
+# base types; revolute and prismatic joints, and spherical joints mixed in (ids "-sph")
+ONE_DOF = (J.REVOLUTE, J.PRISMATIC)
+MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL)
 RANDOM_CASES = [
-    (1, 0, False, 0.3), (1, 1, True, 0.3), (2, 2, False, 0.5), (3, 3, True, 0.9), (5, 4, False, 0.7),
-    (7, 5, True, 0.3), (10, 6, False, 0.0), (12, 7, True, 0.5), (15, 8, False, 0.9), (15, 9, True, 0.3),
+    (1, 0, False, 0.3, ONE_DOF), (1, 1, True, 0.3, ONE_DOF), (2, 2, False, 0.5, ONE_DOF), (3, 3, True, 0.9, ONE_DOF),
+    (5, 4, False, 0.7, ONE_DOF), (7, 5, True, 0.3, ONE_DOF), (10, 6, False, 0.0, ONE_DOF), (12, 7, True, 0.5, ONE_DOF),
+    (15, 8, False, 0.9, ONE_DOF), (15, 9, True, 0.3, ONE_DOF), (6, 11, False, 0.4, MIXED), (8, 10, True, 0.5, MIXED),
 ]
-RANDOM_MODELS = [random_model(n, seed=s, floating_base=fb, branching=b) for n, s, fb, b in RANDOM_CASES]
-RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}" for n, s, fb, b in RANDOM_CASES]
-FIXED_BASE_MODELS = [m for m in RANDOM_MODELS if not m.floating_base]
-FIXED_BASE_IDS = [i for m, i in zip(RANDOM_MODELS, RANDOM_IDS) if not m.floating_base]
+RANDOM_MODELS = [random_model(n, seed=s, floating_base=fb, branching=b, joint_types=jt)
+                 for n, s, fb, b, jt in RANDOM_CASES]
+RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}{'-sph' if J.SPHERICAL in jt else ''}"
+              for n, s, fb, b, jt in RANDOM_CASES]
+# Models whose velocity is the derivative of the configuration (no free or spherical joint,
+# whose angular velocities are quasi-velocities): identities in coordinates hold on them.
+FIXED_BASE_MODELS = [m for m in RANDOM_MODELS if np.all(J.QUAT_OFFSET[m.joint_type] < 0)]
+FIXED_BASE_IDS = [i for m, i in zip(RANDOM_MODELS, RANDOM_IDS) if np.all(J.QUAT_OFFSET[m.joint_type] < 0)]
 
 random_models = pytest.mark.parametrize("model", RANDOM_MODELS, ids=RANDOM_IDS)
 fixed_base_models = pytest.mark.parametrize("model", FIXED_BASE_MODELS, ids=FIXED_BASE_IDS)
@@ -100,39 +108,44 @@ def quat_to_matrix(quat) -> np.ndarray:
     return Rotation.from_quat(quat).as_matrix()
 
 
-def _free_joints(model: rd.Model):
-    for i in np.flatnonzero(model.joint_type == J.FREE):
-        yield int(model.idx_q[i]), int(model.idx_v[i])
+def _rotation_joints(model: rd.Model):
+    """``(q index, v index, free)`` of the free and spherical joints."""
+    for i in np.flatnonzero((model.joint_type == J.FREE) | (model.joint_type == J.SPHERICAL)):
+        yield int(model.idx_q[i]), int(model.idx_v[i]), bool(model.joint_type[i] == J.FREE)
 
 
 def _scalar_joints(model: rd.Model) -> tuple[np.ndarray, np.ndarray]:
-    one = model.joint_type != J.FREE
+    one = (model.joint_type != J.FREE) & (model.joint_type != J.SPHERICAL)
     return model.idx_q[one], model.idx_v[one]
 
 
 def integrate(model: rd.Model, q, v, dt: float) -> np.ndarray:
     """``q`` moved for ``dt`` along ``v``: 1-dof joints by ``v dt``; a free joint's position by
-    ``R v_lin dt`` and its orientation by ``R exp(omega dt)`` (``v`` in the base frame), so
-    that the curve leaves ``q`` with velocity ``v``."""
+    ``R v_lin dt`` and its orientation (a spherical joint's too) by ``R exp(omega dt)`` (``v``
+    in the child frame), so that the curve leaves ``q`` with velocity ``v``."""
     q = np.array(q, dtype=float)
     out = q.copy()
     iq, iv = _scalar_joints(model)
     out[iq] += v[iv] * dt
-    for kq, kv in _free_joints(model):
-        R = quat_to_matrix(q[kq + 3:kq + 7])
-        out[kq:kq + 3] += R @ v[kv:kv + 3] * dt
-        out[kq + 3:kq + 7] = quat_mul(q[kq + 3:kq + 7], quat_exp(v[kv + 3:kv + 6] * dt))
+    for kq, kv, free in _rotation_joints(model):
+        k, o = (kq + 3, kv + 3) if free else (kq, kv)
+        if free:
+            out[kq:kq + 3] += quat_to_matrix(q[k:k + 4]) @ v[kv:kv + 3] * dt
+        out[k:k + 4] = quat_mul(q[k:k + 4], quat_exp(v[o:o + 3] * dt))
     return out
 
 
 def configuration_rate(model: rd.Model, q, v) -> np.ndarray:
-    """``dq/dt`` for velocity ``v`` (free joint: ``R v_lin`` and ``quat (omega, 0) / 2``)."""
+    """``dq/dt`` for velocity ``v`` (free joint: ``R v_lin`` and ``quat (omega, 0) / 2``; a
+    spherical joint: ``quat (omega, 0) / 2``)."""
     qd = np.zeros(model.nq)
     iq, iv = _scalar_joints(model)
     qd[iq] = v[iv]
-    for kq, kv in _free_joints(model):
-        qd[kq:kq + 3] = quat_to_matrix(q[kq + 3:kq + 7]) @ v[kv:kv + 3]
-        qd[kq + 3:kq + 7] = 0.5 * quat_mul(q[kq + 3:kq + 7], np.append(v[kv + 3:kv + 6], 0.0))
+    for kq, kv, free in _rotation_joints(model):
+        k, o = (kq + 3, kv + 3) if free else (kq, kv)
+        if free:
+            qd[kq:kq + 3] = quat_to_matrix(q[k:k + 4]) @ v[kv:kv + 3]
+        qd[k:k + 4] = 0.5 * quat_mul(q[k:k + 4], np.append(v[o:o + 3], 0.0))
     return qd
 
 

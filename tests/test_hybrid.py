@@ -16,13 +16,15 @@ from urdf_subset import load_pair, pairs
 
 
 def random_mask(model: rd.Model, rng: np.random.Generator) -> np.ndarray:
-    """A random mask with both kinds of entries where possible, a free joint's six alike."""
+    """A random mask with both kinds of entries where possible, the dofs of one joint alike
+    (a free joint's six, a spherical joint's three)."""
     mask = rng.random(model.nv) < 0.5
-    for i in np.flatnonzero(model.joint_type == J.FREE):
-        k = model.idx_v[i]
-        mask[k:k + 6] = mask[k]
-    if model.nv > 1 and (mask.all() or not mask.any()):
-        mask[-1] = not mask[-1]
+    for i in range(model.nbodies):
+        k, n = model.idx_v[i], J.NV[model.joint_type[i]]
+        mask[k:k + n] = mask[k]
+    if model.nbodies > 1 and (mask.all() or not mask.any()):
+        k = model.idx_v[-1]
+        mask[k:] = not mask[k]
     return mask
 
 
@@ -162,7 +164,7 @@ def test_bad_masks():
         call(model, q, v, a, a, np.full(nv, 0.5))
     partial = np.zeros(nv, bool)
     partial[:3] = True
-    with pytest.raises(ValueError, match=r"known_mask: the six entries 0\.\.5 of free joint 'root_joint' must be all "
+    with pytest.raises(ValueError, match=r"known_mask: the 6 entries 0\.\.5 of free joint 'root_joint' must be all "
                                          r"True .* or all False"):
         call(model, q, v, a, a, partial)
     ints = np.r_[np.ones(6, int), np.zeros(nv - 6, int)]

@@ -30,6 +30,8 @@ def poses_by_hand(model, q):
             R = _rodrigues(axis, q[iq])
         elif model.joint_type[i] == J.PRISMATIC:
             p = axis * q[iq]
+        elif model.joint_type[i] == J.SPHERICAL:
+            R = quat_to_matrix(q[iq:iq + 4])
         else:
             R, p = quat_to_matrix(q[iq + 3:iq + 7]), q[iq:iq + 3]
         T = np.eye(4)

@@ -45,7 +45,7 @@ def test_named_columns_hold_the_model(seed):
     np.testing.assert_array_equal(k.params[True][L.GRAVITY:L.GRAVITY + 3], m.gravity)
     np.testing.assert_array_equal(k.params[False][L.GRAVITY:L.GRAVITY + 3], 0.0)
     assert k.params[True][L.SMOOTHING] == m.coulomb_smoothing == k.params[False][L.SMOOTHING]
-    assert k.free_bodies == tuple(np.flatnonzero(m.joint_type == J.FREE))
+    assert k.multi_dof_bodies == tuple(np.flatnonzero(J.NV[m.joint_type] > 1))
 
 
 def test_packed_array_is_the_tables_in_order():

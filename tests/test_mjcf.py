@@ -40,12 +40,12 @@ def _corpus() -> dict[str, Path]:
 
 CORPUS = _corpus()
 
-# Files refused, with the reason: what robodyn does not read yet, or files that are not models.
+# Files refused, with the reason: what robodyn does not read yet (inertia from meshes), or files
+# that are not models.
 REFUSED = {
     "dm_control/mjcf/schema.xml": "root element must be <mujoco>",
     "dm_control/mjcf/test_assets/attribute_test_schema.xml": "root element must be <mujoco>",
-    "dm_control/mujoco/testing/assets/model_with_ball_joints.xml": "ball joints are not supported",
-    "mujoco/testdata/model.xml": "ball joints are not supported",
+    "mujoco/testdata/model.xml": "inertia from a mesh geom",
     "dm_control/suite/dog.xml": "inertia from a mesh geom",
     "dm_control/locomotion/walkers/assets/dog_v2/dog.xml": "inertia from a mesh geom",
     "dm_control/locomotion/walkers/assets/dog_v2/scene.xml": "inertia from a mesh geom",
@@ -88,6 +88,9 @@ def _random_qpos(mm, rng) -> np.ndarray:
     for j in np.flatnonzero(mm.jnt_type == mujoco.mjtJoint.mjJNT_FREE):
         a = mm.jnt_qposadr[j]
         qpos[a + 3:a + 7] /= np.linalg.norm(qpos[a + 3:a + 7])
+    for j in np.flatnonzero(mm.jnt_type == mujoco.mjtJoint.mjJNT_BALL):
+        a = mm.jnt_qposadr[j]
+        qpos[a:a + 4] /= np.linalg.norm(qpos[a:a + 4])
     return qpos
 
 
@@ -182,9 +185,8 @@ def test_wheel_models_load_and_match_mujoco_or_are_refused(rel):
 def test_wheel_model_counts():
     """The README states these numbers."""
     assert len(CORPUS) == 81
-    assert len(CORPUS) - len(REFUSED) - len(BOTH_REFUSE) - len(MUJOCO_REFUSES) == 62
-    assert sum("ball joints" in r for r in REFUSED.values()) == 2
-    assert sum("mesh" in r for r in REFUSED.values()) == 11
+    assert len(CORPUS) - len(REFUSED) - len(BOTH_REFUSE) - len(MUJOCO_REFUSES) == 63
+    assert sum("mesh" in r for r in REFUSED.values()) == 12
 
 
 # ----------------------------------------------------------------------------------------
@@ -257,6 +259,20 @@ def test_several_joints_in_one_body_make_a_chain_of_massless_bodies():
     assert model.link_names == ("hip:x", "hip:y", "hip", "shin")
     assert model.body_joint_names == ("x", "y", "s", "knee")
     assert model.inertia[0, 0] == model.inertia[1, 0] == 0
+
+
+def test_ball_joints_are_spherical_joints():
+    """A ball joint about an anchor, alone and in a chain with hinges, anywhere in the tree."""
+    xml = _mjcf('<body name="base" pos="0 0 1"><freejoint/><geom type="box" size="0.2 0.1 0.05"/>'
+                '<body name="arm" pos="0.2 0 0" euler="10 20 30"><joint name="shoulder" type="ball" pos="0.01 0.02 0" '
+                'damping="0.3" armature="0.05"/><geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.03"/>'
+                '<body name="hand" pos="0.3 0 0"><joint name="grip" axis="0 1 0" pos="0 0 0.02"/>'
+                '<joint name="wrist" type="ball" pos="0.01 0 0"/><geom size="0.04"/><site name="tip" pos="0.05 0 0"/>'
+                '</body></body></body>')
+    model = check(xml)
+    assert model.nq == 7 + 4 + 1 + 4 and model.nv == 6 + 3 + 1 + 3
+    assert model.link_names == ("base", "arm", "hand:grip", "hand")
+    np.testing.assert_allclose(model.damping[6:9], 0.3)
 
 
 def test_free_bodies_and_welded_bodies():
@@ -379,7 +395,6 @@ def test_a_plain_model_loads_without_warning():
 # ----------------------------------------------------------------------------------------
 
 BAD = [
-    (_mjcf('<body><joint type="ball"/><geom size="0.1"/></body>'), "<joint> (line 1): ball joints are not supported"),
     (_mjcf('<body><joint type="hinge2"/><geom size="0.1"/></body>'), "unknown joint type 'hinge2'"),
     (_mjcf('<body><joint/><geom type="mesh" mesh="m"/></body>'), "inertia from a mesh geom is not supported"),
     (_mjcf('<body><joint/><geom size="0.1" shellinertia="true"/></body>'), "shell inertia is not supported"),

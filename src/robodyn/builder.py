@@ -34,7 +34,7 @@ from .errors import RobodynWarning
 from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from, inertial_parameters_in_parent
 
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
-               "fixed": None}
+               "spherical": J.SPHERICAL, "fixed": None}
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -145,7 +145,8 @@ class ModelBuilder:
         """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
         in the parent link frame and the child frame coincides with it at ``q = 0``.
 
-        ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``fixed`` or ``free`` (a
+        ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``fixed``, ``spherical`` (a ball
+        joint: ``q = [qx, qy, qz, qw]`` rotates the child in the joint frame) or ``free`` (a
         6-dof joint, whose parent link must be the root or welded to it: its configuration
         ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame)."""
         where = where or f"{self.source}: joint {name!r}"
@@ -158,14 +159,14 @@ class ModelBuilder:
             if not np.all(np.isfinite(a)):
                 raise ModelError(f"{where}: {what} is not finite")
         R = rpy_to_matrix(rot) if rotation is None else rot
-        if type == "free":
+        if type in ("free", "spherical"):
             ax = np.zeros(3)
         elif type != "fixed":
             n = np.linalg.norm(ax)
             if n < 1e-12:
                 raise ModelError(f"{where}: joint axis is zero")
             ax = ax / n
-        if type in ("continuous", "free"):
+        if type in ("continuous", "free", "spherical"):
             lower, upper = -np.inf, np.inf
         limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
                       effort=float(effort), damping=float(damping), friction=float(friction),

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._jit import inline
 from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, XTREE_P, XTREE_R
-from .joints import PRISMATIC, QUAT_TOL, REVOLUTE
+from .joints import PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
@@ -23,7 +23,7 @@ def _mix(row, j, c, s):
 def local_placement(jtype, row, q, iq, Rj):
     """``(ok, R, p)``: the placement of a body in its parent, ``X_tree * X_J(q)``, from the
     body's kernel row (``layout.pack``), as values: ``R`` a 9-tuple (row by row), ``p`` a
-    3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a free joint's quaternion is
+    3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a joint's quaternion is
     farther than ``QUAT_TOL`` from unit norm (a near-unit quaternion is normalised)."""
     P, J, R = XTREE_P, JOINT_CONSTANTS, XTREE_R
     if jtype == REVOLUTE:
@@ -37,23 +37,42 @@ def local_placement(jtype, row, q, iq, Rj):
         return (True, (row[R], row[R + 1], row[R + 2], row[R + 3], row[R + 4], row[R + 5], row[R + 6], row[R + 7],
                        row[R + 8]),
                 (row[P] + row[J] * x, row[P + 1] + row[J + 1] * x, row[P + 2] + row[J + 2] * x))
+    if jtype == SPHERICAL:  # X_tree * rotation of the quaternion
+        if not unit_rotation(q, iq, Rj):
+            return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        return True, _tree_rotation(row, Rj), (row[P], row[P + 1], row[P + 2])
     # FREE: X_tree * (rotation of the quaternion, position)
-    n = np.sqrt(q[iq + 3] * q[iq + 3] + q[iq + 4] * q[iq + 4] + q[iq + 5] * q[iq + 5] + q[iq + 6] * q[iq + 6])
-    if not abs(n - 1.0) <= QUAT_TOL:
+    if not unit_rotation(q, iq + 3, Rj):
         return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
-    rotation_from_quaternion(q[iq + 3] / n, q[iq + 4] / n, q[iq + 5] / n, q[iq + 6] / n, Rj)
     x, y, z = q[iq], q[iq + 1], q[iq + 2]
-    return (True, (row[0] * Rj[0, 0] + row[1] * Rj[1, 0] + row[2] * Rj[2, 0],
-                   row[0] * Rj[0, 1] + row[1] * Rj[1, 1] + row[2] * Rj[2, 1],
-                   row[0] * Rj[0, 2] + row[1] * Rj[1, 2] + row[2] * Rj[2, 2],
-                   row[3] * Rj[0, 0] + row[4] * Rj[1, 0] + row[5] * Rj[2, 0],
-                   row[3] * Rj[0, 1] + row[4] * Rj[1, 1] + row[5] * Rj[2, 1],
-                   row[3] * Rj[0, 2] + row[4] * Rj[1, 2] + row[5] * Rj[2, 2],
-                   row[6] * Rj[0, 0] + row[7] * Rj[1, 0] + row[8] * Rj[2, 0],
-                   row[6] * Rj[0, 1] + row[7] * Rj[1, 1] + row[8] * Rj[2, 1],
-                   row[6] * Rj[0, 2] + row[7] * Rj[1, 2] + row[8] * Rj[2, 2]),
+    return (True, _tree_rotation(row, Rj),
             (row[9] + row[0] * x + row[1] * y + row[2] * z, row[10] + row[3] * x + row[4] * y + row[5] * z,
              row[11] + row[6] * x + row[7] * y + row[8] * z))
+
+
+@inline
+def unit_rotation(q, k, Rj):
+    """The rotation of the quaternion ``q[k:k + 4]`` (normalised) into ``Rj``; False when its
+    norm is farther than ``QUAT_TOL`` from 1."""
+    n = np.sqrt(q[k] * q[k] + q[k + 1] * q[k + 1] + q[k + 2] * q[k + 2] + q[k + 3] * q[k + 3])
+    if not abs(n - 1.0) <= QUAT_TOL:
+        return False
+    rotation_from_quaternion(q[k] / n, q[k + 1] / n, q[k + 2] / n, q[k + 3] / n, Rj)
+    return True
+
+
+@inline
+def _tree_rotation(row, Rj):
+    """``X_tree_R Rj`` (row by row, a 9-tuple) from the body's kernel row."""
+    return (row[0] * Rj[0, 0] + row[1] * Rj[1, 0] + row[2] * Rj[2, 0],
+            row[0] * Rj[0, 1] + row[1] * Rj[1, 1] + row[2] * Rj[2, 1],
+            row[0] * Rj[0, 2] + row[1] * Rj[1, 2] + row[2] * Rj[2, 2],
+            row[3] * Rj[0, 0] + row[4] * Rj[1, 0] + row[5] * Rj[2, 0],
+            row[3] * Rj[0, 1] + row[4] * Rj[1, 1] + row[5] * Rj[2, 1],
+            row[3] * Rj[0, 2] + row[4] * Rj[1, 2] + row[5] * Rj[2, 2],
+            row[6] * Rj[0, 0] + row[7] * Rj[1, 0] + row[8] * Rj[2, 0],
+            row[6] * Rj[0, 1] + row[7] * Rj[1, 1] + row[8] * Rj[2, 1],
+            row[6] * Rj[0, 2] + row[7] * Rj[1, 2] + row[8] * Rj[2, 2])
 
 
 @inline

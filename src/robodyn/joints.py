@@ -12,7 +12,12 @@ type        nq   nv   configuration and velocity
 revolute    1    1    angle about ``axis`` (continuous joints are revolute joints)
 prismatic   1    1    displacement along ``axis``
 free        7    6    ``[x, y, z, qx, qy, qz, qw]``, ``[v_lin, omega]`` in the child frame
+spherical   4    3    ``[qx, qy, qz, qw]`` (a ball joint), ``omega`` in the child frame
 =========== ==== ==== ================================================================
+
+Free and spherical joints hold a unit quaternion (scalar last) at ``QUAT_OFFSET`` in their
+``q`` and move on SO(3) by the right: ``q (+) v`` rotates by ``exp(omega)`` in the child
+frame, as Pinocchio's ``JointModelFreeFlyer`` and ``JointModelSpherical`` do.
 """
 
 from __future__ import annotations
@@ -23,10 +28,34 @@ import numpy as np
 REVOLUTE = 0
 PRISMATIC = 1
 FREE = 2
+SPHERICAL = 3
 
-NAMES = ("revolute", "prismatic", "free")
-NQ = np.array([1, 1, 7], dtype=np.int64)
-NV = np.array([1, 1, 6], dtype=np.int64)
+NAMES = ("revolute", "prismatic", "free", "spherical")
+NQ = np.array([1, 1, 7, 4], dtype=np.int64)
+NV = np.array([1, 1, 6, 3], dtype=np.int64)
+# Where a joint's unit quaternion starts in its q (-1: none); where its angular velocity starts in v.
+QUAT_OFFSET = np.array([-1, -1, 3, 0], dtype=np.int64)
+OMEGA_OFFSET = np.array([-1, -1, 3, 0], dtype=np.int64)
+
+
+# Names of the entries of a joint's q and v (a joint of one entry goes by the joint's name alone).
+Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "qz", "qw"))
+V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"))
+
+
+def coordinate_names(joint_types, joint_names, kind: str = "v", sep: str = "[") -> list[str]:
+    """One name per entry of ``v`` (``kind="v"``) or ``q`` (``"q"``): the joint's name, or
+    ``name[vx]``, ``name[wx]`` ... (``sep="["``) / ``name:vx`` (``sep=":"``) for the entries
+    of a free or spherical joint."""
+    parts = V_COMPONENTS if kind == "v" else Q_COMPONENTS
+    out = []
+    for jt, name in zip(joint_types, joint_names):
+        comps = parts[int(jt)]
+        if not comps:
+            out.append(name)
+        else:
+            out.extend(f"{name}[{c}]" if sep == "[" else f"{name}{sep}{c}" for c in comps)
+    return out
 
 
 def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
@@ -37,10 +66,12 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
         return np.concatenate([axis, np.zeros(3)])[None, :]
     if jtype == FREE:
         return np.eye(6)
+    if jtype == SPHERICAL:
+        return np.eye(6)[3:]
     raise ValueError(f"unknown joint type code {jtype}")
 
 
-# A free joint's quaternion may be this far from unit norm; it is normalised, farther is an error.
+# A free or spherical joint's quaternion may be this far from unit norm; it is normalised, farther is an error.
 QUAT_TOL = 1e-3
 
 

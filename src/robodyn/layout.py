@@ -25,7 +25,7 @@ The tables (built once per model by :func:`pack`, reached as ``model.kernel``):
     (viscous) and ``COULOMB``, zeroed when switched off.
 ``params[with_gravity]`` (PARAMS_SIZE,): gravity (``GRAVITY``, 3, or zeros) and the Coulomb
     smoothing velocity (``SMOOTHING``).
-``zero_wrench`` (nb, 6): no external wrench. ``free_bodies``: the bodies whose joint is free.
+``zero_wrench`` (nb, 6): no external wrench. ``multi_dof_bodies``: the bodies whose joint has several dofs (free, spherical).
 ``packed[(friction, armature)]``: ``body``, that ``dofs``, ``params[True]`` and
     ``zero_wrench`` raveled into one array for the single-state fast paths, where each argument
     costs Numba's dispatcher about 0.1 us (``algorithms._inputs.unpack`` takes it apart).
@@ -70,7 +70,7 @@ class KernelTables(NamedTuple):
     params: dict
     zero_wrench: np.ndarray
     packed: dict
-    free_bodies: tuple
+    multi_dof_bodies: tuple
 
 
 def pack(model) -> KernelTables:
@@ -122,5 +122,5 @@ def pack(model) -> KernelTables:
     zero_wrench = np.zeros((nb, 6))
     packed = {key: np.concatenate([body.ravel(), d.ravel(), params[True], zero_wrench.ravel()])
               for key, d in dofs.items()}
-    free_bodies = tuple(int(i) for i in np.flatnonzero(model.joint_type == J.FREE))
-    return KernelTables(ints, body, dofs, params, zero_wrench, packed, free_bodies)
+    multi_dof_bodies = tuple(int(i) for i in np.flatnonzero(J.NV[model.joint_type] > 1)) if nb else ()
+    return KernelTables(ints, body, dofs, params, zero_wrench, packed, multi_dof_bodies)

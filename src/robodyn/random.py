@@ -1,7 +1,8 @@
 """Seeded random models and states, for tests, benchmarks and experiments.
 
-``random_model(nbodies, seed=0, floating_base=False, branching=0.3)`` builds a tree with
-revolute and prismatic joints on random axes and placements, and random physically
+``random_model(nbodies, seed=0, floating_base=False, branching=0.3, joint_types=...)`` builds
+a tree with revolute and prismatic joints (by default; spherical joints on request) on random
+axes and placements, and random physically
 consistent inertias (positive masses, principal moments satisfying the triangle
 inequality). ``random_state(model, rng)`` draws ``(q, v, a)`` with unit quaternions.
 """
@@ -75,11 +76,13 @@ def random_configuration(model: Model, rng: np.random.Generator, size=()) -> np.
     """Random ``q`` (size + (nq,)): joints in [-pi, pi], positions in [-1, 1], unit quaternions."""
     size = (size,) if isinstance(size, int) else tuple(size)
     q = rng.uniform(-np.pi, np.pi, size + (model.nq,))
-    for i in np.flatnonzero(model.joint_type == J.FREE):
+    for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
         k = model.idx_q[i]
-        q[..., k:k + 3] = rng.uniform(-1, 1, size + (3,))
+        if model.joint_type[i] == J.FREE:
+            q[..., k:k + 3] = rng.uniform(-1, 1, size + (3,))
         quat = rng.standard_normal(size + (4,))
-        q[..., k + 3:k + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+        k += J.QUAT_OFFSET[model.joint_type[i]]
+        q[..., k:k + 4] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
     return q
 
 

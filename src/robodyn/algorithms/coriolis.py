@@ -194,9 +194,9 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``, symmetric in ``j, k``, and
     ``coriolis_matrix(q, v)[i, j] == sum_k Gamma[i, j, k] v[k]``. Since ``C`` is linear in
     ``v``, ``Gamma[..., :, :, k] = C(q, e_k)``. For a floating base the base velocity is a
-    quasi-velocity (not the derivative of ``q``); ``Gamma`` is then still defined by
-    ``C(q, e_k)`` and satisfies ``C = Gamma v``, but it is not symmetric in ``j, k`` for the
-    base directions.
+    quasi-velocity (not the derivative of ``q``), as is the angular velocity of a spherical
+    joint; ``Gamma`` is then still defined by ``C(q, e_k)`` and satisfies ``C = Gamma v``, but
+    it is not symmetric in ``j, k`` for those directions.
     """
     batch, x = _inputs.states(model, q=q)
     nv = model.nv

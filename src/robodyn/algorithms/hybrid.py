@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import inline, kernel
+from .. import joints as J
 from . import _inputs
 from .status import raise_for_status
 from .status import OK
@@ -51,8 +52,8 @@ def _hybrid_single(ints, body, dofs, params, q, v, a, tau_in, known, fext, fcode
 
 
 def known_dofs(model, known_mask) -> np.ndarray:
-    """``known_mask`` checked: a boolean (nv,) array in which the six entries of a free joint
-    are all True or all False."""
+    """``known_mask`` checked: a boolean (nv,) array in which the entries of a joint of several
+    dofs (free, spherical) are all True or all False."""
     mask = np.asarray(known_mask)
     if mask.shape != (model.nv,):
         raise ValueError(f"known_mask: expected shape ({model.nv},), got {mask.shape}")
@@ -60,13 +61,14 @@ def known_dofs(model, known_mask) -> np.ndarray:
         if not (np.issubdtype(mask.dtype, np.integer) and np.all((mask == 0) | (mask == 1))):
             raise ValueError(f"known_mask: expected booleans (or 0/1), got {mask.dtype} values {mask.tolist()}")
         mask = mask.astype(bool)
-    for i in model.kernel.free_bodies:
-        k = model.idx_v[i]
-        block = mask[k:k + 6]
+    for i in model.kernel.multi_dof_bodies:
+        k, n = model.idx_v[i], int(J.NV[model.joint_type[i]])
+        block = mask[k:k + n]
         if block.any() != block.all():
+            kind = J.NAMES[model.joint_type[i]]
             raise ValueError(
-                f"known_mask: the six entries {k}..{k + 5} of free joint {model.body_joint_names[i]!r} must be "
-                f"all True (base acceleration given) or all False (base wrench given), got {block.tolist()}")
+                f"known_mask: the {n} entries {k}..{k + n - 1} of {kind} joint {model.body_joint_names[i]!r} must be "
+                f"all True (joint acceleration given) or all False (joint force given), got {block.tolist()}")
     return np.ascontiguousarray(mask)
 
 

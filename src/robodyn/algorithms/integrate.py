@@ -2,7 +2,8 @@
 
 Configurations of 1-dof joints add: ``q_i + v_i``. A free joint's configuration is a pose
 ``(p, R)`` (``q = [p, quaternion (x, y, z, w)]``) and its velocity a twist ``[v_lin, omega]``
-in the child (base) frame; it moves by the exponential map of SE(3), as Pinocchio does::
+in the child (base) frame; it moves by the exponential map of SE(3), as Pinocchio does (a
+spherical joint, ``q = quaternion``, ``v = omega``, by its rotation part, that of SO(3))::
 
     integrate:   (p, R) ⊕ xi = (p, R) exp(xi),      exp(xi) = (V(omega) v_lin, exp3(omega))
     difference:  q1 ⊖ q0 = log((p0, R0)^-1 (p1, R1))
@@ -26,12 +27,30 @@ from .status import require_finite_result
 
 
 def _free_blocks(model):
-    for i in np.flatnonzero(model.joint_type == J.FREE):
-        yield int(model.idx_q[i]), int(model.idx_v[i])
+    """``(q index, v index, translation)`` of each free (True) and spherical (False) joint. A
+    spherical joint is handled as a free joint without translation: its blocks are the
+    rotation parts of the free joint's (see :func:`_pose` and :func:`_tangent`)."""
+    for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
+        yield int(model.idx_q[i]), int(model.idx_v[i]), bool(model.joint_type[i] == J.FREE)
+
+
+def _pose(q, kq, free):
+    """``(position (..., 3), quaternion (..., 4))`` of the joint at ``kq`` (zero position for a
+    spherical joint)."""
+    if free:
+        return q[..., kq:kq + 3], q[..., kq + 3:kq + 7]
+    return np.zeros(q.shape[:-1] + (3,)), q[..., kq:kq + 4]
+
+
+def _tangent(v, kv, free):
+    """The joint's velocity as a twist (..., 6) ``[v_lin, omega]`` (zero ``v_lin`` if spherical)."""
+    if free:
+        return v[..., kv:kv + 6]
+    return np.concatenate([np.zeros(v.shape[:-1] + (3,)), v[..., kv:kv + 3]], -1)
 
 
 def _scalar_indices(model):
-    one = model.joint_type != J.FREE
+    one = J.QUAT_OFFSET[model.joint_type] < 0
     return model.idx_q[one], model.idx_v[one]
 
 
@@ -56,13 +75,18 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     out = q.copy()
     iq, iv = _scalar_indices(model)
     out[..., iq] += v[..., iv]
-    for kq, kv in _free_blocks(model):
-        quat0 = q[..., kq + 3:kq + 7] / np.linalg.norm(q[..., kq + 3:kq + 7], axis=-1, keepdims=True)
-        dquat, dp = exp_se3(v[..., kv:kv + 6])
-        out[..., kq:kq + 3] = q[..., kq:kq + 3] + np.einsum("...ij,...j->...i", quat_matrix(quat0), dp)
+    for kq, kv, free in _free_blocks(model):
+        p0, quat0 = _pose(q, kq, free)
+        quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
+        dquat, dp = exp_se3(_tangent(v, kv, free))
         quat = quat_mul(quat0, dquat)
         quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
-        out[..., kq + 3:kq + 7] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+        quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+        if free:
+            out[..., kq:kq + 3] = p0 + np.einsum("...ij,...j->...i", quat_matrix(quat0), dp)
+            out[..., kq + 3:kq + 7] = quat
+        else:
+            out[..., kq:kq + 4] = quat
     require_finite_result("integrate", out, check_finite, {"q": q, "v": v})
     return _inputs.unflatten(out, batch)
 
@@ -89,12 +113,13 @@ def _difference(model, q0, q1, check_finite: bool, what: str) -> np.ndarray:
     d = np.zeros(lead + (model.nv,))
     iq, iv = _scalar_indices(model)
     d[..., iv] = q1[..., iq] - q0[..., iq]
-    for kq, kv in _free_blocks(model):
-        quat0, quat1 = q0[..., kq + 3:kq + 7], q1[..., kq + 3:kq + 7]
+    for kq, kv, free in _free_blocks(model):
+        (p0, quat0), (p1, quat1) = _pose(q0, kq, free), _pose(q1, kq, free)
         quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
         conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
-        dp = np.einsum("...ji,...j->...i", quat_matrix(quat0), q1[..., kq:kq + 3] - q0[..., kq:kq + 3])
-        d[..., kv:kv + 6] = log_se3(quat_mul(conj0, quat1), dp)
+        dp = np.einsum("...ji,...j->...i", quat_matrix(quat0), p1 - p0)
+        xi = log_se3(quat_mul(conj0, quat1), dp)
+        d[..., kv:kv + 6 if free else kv + 3] = xi if free else xi[..., 3:]
     return require_finite_result(what, d, check_finite, {"q0": q0, "q1": q1})
 
 
@@ -112,11 +137,12 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     check_configurations(model, check_finite, "integrate_jacobians", q=q, v=v)
     Jq = np.broadcast_to(np.eye(model.nv), q.shape[:-1] + (model.nv, model.nv)).copy()
     Jv = Jq.copy()
-    for _, kv in _free_blocks(model):
-        xi = v[..., kv:kv + 6]
+    for _, kv, free in _free_blocks(model):
+        xi = _tangent(v, kv, free)
         quat, p = exp_se3(xi)
-        Jq[..., kv:kv + 6, kv:kv + 6] = inverse_adjoint(quat, p)
-        Jv[..., kv:kv + 6, kv:kv + 6] = right_jacobian_se3(xi)
+        n, o = (6, 0) if free else (3, 3)  # a spherical joint: the rotation blocks
+        Jq[..., kv:kv + n, kv:kv + n] = inverse_adjoint(quat, p)[..., o:, o:]
+        Jv[..., kv:kv + n, kv:kv + n] = right_jacobian_se3(xi)[..., o:, o:]
     return _inputs.unflatten(Jq, batch), _inputs.unflatten(Jv, batch)
 
 
@@ -131,10 +157,11 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
     d = _difference(model, q0, q1, check_finite, "difference_jacobians")
     J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
     J0 = -J1
-    for _, kv in _free_blocks(model):
-        xi = d[..., kv:kv + 6]
-        J1[..., kv:kv + 6, kv:kv + 6] = np.linalg.inv(right_jacobian_se3(xi))
-        J0[..., kv:kv + 6, kv:kv + 6] = -np.linalg.inv(right_jacobian_se3(-xi))
+    for _, kv, free in _free_blocks(model):
+        xi = _tangent(d, kv, free)
+        n, o = (6, 0) if free else (3, 3)
+        J1[..., kv:kv + n, kv:kv + n] = np.linalg.inv(right_jacobian_se3(xi)[..., o:, o:])
+        J0[..., kv:kv + n, kv:kv + n] = -np.linalg.inv(right_jacobian_se3(-xi)[..., o:, o:])
     return J0, J1
 
 
@@ -150,7 +177,7 @@ def _as_configuration(model, name: str, a) -> np.ndarray:
 
 def check_configurations(model, check_finite: bool, what: str, **arrays) -> None:
     """NaN/Inf in any of ``arrays`` (by name, when ``check_finite``) and the unit norm of the
-    free joints' quaternions in those of the configuration's size; errors start with ``what``."""
+    free and spherical joints' quaternions in those of the configuration's size; errors start with ``what``."""
     if check_finite:
         for name, a in arrays.items():
             if not np.all(np.isfinite(a)):
@@ -159,8 +186,9 @@ def check_configurations(model, check_finite: bool, what: str, **arrays) -> None
     for name, a in arrays.items():
         if a.shape[-1] != model.nq:
             continue
-        for kq, _ in _free_blocks(model):
-            n = np.linalg.norm(a[..., kq + 3:kq + 7], axis=-1)
+        for kq, _, free in _free_blocks(model):
+            k = kq + 3 if free else kq
+            n = np.linalg.norm(a[..., k:k + 4], axis=-1)
             if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
-                raise ValueError(f"{what}: {name}: quaternion {name}[{kq + 3}:{kq + 7}] has norm "
+                raise ValueError(f"{what}: {name}: quaternion {name}[{k}:{k + 4}] has norm "
                                  f"{float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))]):.6g}, not 1; normalise it")

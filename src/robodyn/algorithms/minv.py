@@ -17,10 +17,10 @@ Bodies are numbered after their ancestors, so the dofs of a body's subtree all c
 after its own first dof ``k_i``, before the end ``e_i`` of its subtree's dofs (``ints[i, SUBTREE_END]``):
 ``F_i`` and ``u_i`` are zero outside the columns ``k_i <= col < e_i`` (a unit force outside
 the subtree does not reach it in pass 2), where pass 2 runs. Pass 3 computes the upper
-triangle (columns ``>= k_i`` of the rows of body ``i``), then mirrors it. Only a root's joint may
-have several dofs (a free joint); the column loops of every other body, whose joint has one
-dof, hold the joint's vectors in registers (:func:`bias_forces_one_dof`,
-:func:`accelerations_one_dof`).
+triangle (columns ``>= k_i`` of the rows of body ``i``), then mirrors it. The column loops of a
+body with a parent and a joint of one dof hold the joint's vectors in registers
+(:func:`bias_forces_one_dof`, :func:`accelerations_one_dof`); joints of several dofs (a
+spherical joint anywhere, a free joint at a root) take general loops.
 
 Coordinates: as in the ABA (``aba.py``), each body's quantities are expressed at its origin
 with the world's axes, so that ``iX_p`` is a pure shift by the vector ``d_i`` between the
@@ -44,7 +44,7 @@ from .status import raise_for_status, raise_singular
 from ._inputs import nq_of
 from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from .aba import aligned_placement, articulated_inertia, joint_inertia
+from .aba import aligned_placement, articulated_inertia, joint_acceleration, joint_inertia
 from .driver import batch_kernel, chunks
 
 
@@ -110,6 +110,46 @@ def accelerations_one_dof(k, d, S, U, dinv, F_p, F_i, Minv):
         b[3], b[4], b[5] = w0 + s3 * m, w1 + s4 * m, w2 + s5 * m
 
 
+@inline
+def bias_forces_dofs(iv, n, end, d, S, UD, F_i, F_p, Minv, t):
+    """Pass 2 of a body with a parent whose joint has the ``n`` dofs ``iv..iv+n`` (a spherical
+    joint): as :func:`bias_forces_one_dof`, ``u = E - S^T F_i`` in the rows of the joint's dofs
+    and ``F_p += iX_p^T (F_i + U D^-1 u)`` (``t`` (6,) scratch)."""
+    shift = (d[0], d[1], d[2])
+    for col in range(iv, end):
+        f = F_i[col]
+        for r in range(6):
+            t[r] = f[r]
+        for j in range(n):
+            k = iv + j
+            u = 1.0 if col == k else 0.0
+            for r in range(6):
+                u -= S[k, r] * f[r]
+            Minv[k, col] = u
+            for r in range(6):
+                t[r] += UD[r, j] * u
+        f0, f1, f2, n0, n1, n2 = unshifted_force(shift, (t[0], t[1], t[2], t[3], t[4], t[5]))
+        p = F_p[col]
+        p[0] += f0
+        p[1] += f1
+        p[2] += f2
+        p[3] += n0
+        p[4] += n1
+        p[5] += n2
+
+
+@inline
+def accelerations_dofs(iv, n, d, S, U, Dinv, F_p, F_i, Minv, t):
+    """Pass 3 of a body with a parent whose joint has ``n`` dofs: for the columns ``col >= iv``,
+    ``A' = iX_p A_p``, ``Minv[dofs, col] = D^-1 (u - U^T A')``, ``A_i = A' + S Minv[dofs, col]``."""
+    shift = (d[0], d[1], d[2])
+    for col in range(iv, Minv.shape[1]):
+        b = F_i[col]
+        b[0], b[1], b[2], b[3], b[4], b[5] = shifted_motion(shift, F_p[col])
+        column = Minv[:, col]
+        joint_acceleration(S, U, Dinv, column, iv, n, b, column, t)
+
+
 @core
 def minv_one(ints, body, dofs, q, check, Minv, ws):
     """``Minv`` (nv, nv) at ``q``; returns a status (see ``_inputs``), ``i + 1`` when the
@@ -132,8 +172,6 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         F[i, ints[i, IV]:ints[i, SUBTREE_END], :] = 0.0  # pass 2 uses the columns of the subtree only
     # Pass 2: articulated inertias and the bias forces of the unit joint forces;
     # u_i is kept in the rows of Minv of the joint's dofs until pass 3 replaces it.
-    # Only a root's joint has several dofs (a free joint attaches to the world: see Model),
-    # so a body with a parent has the one dof iv.
     for i in range(nb - 1, -1, -1):
         par, iv, n, end = ints[i, PARENT], ints[i, IV], ints[i, NDOF], ints[i, SUBTREE_END]
         if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
@@ -143,7 +181,10 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
         if par >= 0:
             articulated_inertia(IA[i], U, Dinv, iv, n, UD, Ia)
             congruence_shift(d[i], upper_triangle(Ia), IA[par], True)
-            bias_forces_one_dof(iv, end, d[i], S, UD, F[i], F[par], Minv)
+            if n == 1:
+                bias_forces_one_dof(iv, end, d[i], S, UD, F[i], F[par], Minv)
+            else:
+                bias_forces_dofs(iv, n, end, d[i], S, UD, F[i], F[par], Minv, t1)
             continue
         for k in range(iv, iv + n):  # a root: u_i only
             for col in range(iv, end):
@@ -155,7 +196,10 @@ def minv_one(ints, body, dofs, q, check, Minv, ws):
     for i in range(nb):
         par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if par >= 0:
-            accelerations_one_dof(iv, d[i], S, U, Dinv[iv, 0], F[par], F[i], Minv)
+            if n == 1:
+                accelerations_one_dof(iv, d[i], S, U, Dinv[iv, 0], F[par], F[i], Minv)
+            else:
+                accelerations_dofs(iv, n, d[i], S, U, Dinv, F[par], F[i], Minv, t1)
             continue
         for col in range(iv, nv):  # a root: A_i' = 0
             for k in range(n):

@@ -299,16 +299,11 @@ def extra_columns(model, *, viscous: bool = False, coulomb: bool = False, armatu
 
 
 def dof_names(model) -> list[str]:
-    """One name per entry of ``v``: the joint name, or ``name[vx]`` ... for a free joint."""
-    from ..joints import NV
+    """One name per entry of ``v``: the joint name, or ``name[vx]`` ... for a free joint
+    (``name[wx]`` ... for a spherical joint)."""
+    from ..joints import coordinate_names
 
-    out = []
-    for i in range(model.nbodies):
-        if NV[model.joint_type[i]] == 1:
-            out.append(model.body_joint_names[i])
-        else:
-            out.extend(f"{model.body_joint_names[i]}[{c}]" for c in ("vx", "vy", "vz", "wx", "wy", "wz"))
-    return out
+    return coordinate_names(model.joint_type, model.body_joint_names)
 
 
 def extended_parameters(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,

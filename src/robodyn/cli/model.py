@@ -42,13 +42,13 @@ def cmd_info(args) -> int:
 
 def sample_state(model, seed: int = 0):
     """A reproducible sample state: mid-range joint angles, moderate speeds and accelerations."""
-    from ..joints import FREE
+    from ..joints import QUAT_OFFSET
     from ..random import random_configuration
 
     rng = np.random.default_rng(seed)
     q = random_configuration(model, rng)
-    for i in range(model.nbodies):  # joint angles in [-pi/2, pi/2]; a free joint stays as drawn
-        if model.joint_type[i] != FREE:
+    for i in range(model.nbodies):  # joint angles in [-pi/2, pi/2]; free and spherical joints as drawn
+        if QUAT_OFFSET[model.joint_type[i]] < 0:
             q[model.idx_q[i]] *= 0.5
     v = rng.uniform(-1.0, 1.0, model.nv)
     a = rng.uniform(-2.0, 2.0, model.nv)
@@ -93,16 +93,9 @@ def cmd_demo(args) -> int:
 
 
 def _dof_names(model) -> list[str]:
-    from ..joints import NV
+    from ..joints import coordinate_names
 
-    names = []
-    for i in range(model.nbodies):
-        n = int(NV[model.joint_type[i]])
-        if n == 1:
-            names.append(model.body_joint_names[i])
-        else:
-            names.extend(f"{model.body_joint_names[i]}[{c}]" for c in ("vx", "vy", "vz", "wx", "wy", "wz")[:n])
-    return names
+    return coordinate_names(model.joint_type, model.body_joint_names)
 
 
 def cmd_bench(args) -> int:

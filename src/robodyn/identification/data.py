@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path
-from ..joints import FREE
+from ..joints import FREE, SPHERICAL
 
 KINDS = ("q", "qd", "qdd", "tau")
 
@@ -47,6 +47,8 @@ class Log:
 def _fixed_base(model, what: str) -> None:
     if np.any(model.joint_type == FREE):
         raise ValueError(f"{what}: logs hold the 1-dof joints of a fixed-base model; this model has a free joint")
+    if np.any(model.joint_type == SPHERICAL):
+        raise ValueError(f"{what}: logs hold the 1-dof joints of a fixed-base model; this model has a spherical joint")
 
 
 def column_names(model, kind: str) -> list[str]:

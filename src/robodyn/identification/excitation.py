@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..files import atomic_path
-from ..joints import FREE
+from ..joints import FREE, SPHERICAL
 from ._blas import one_blas_thread
 
 
@@ -108,6 +108,8 @@ def limits_of(model, acceleration=10.0, velocity=None, margin: float = 0.05, spa
     if np.any(model.joint_type == FREE):
         raise ValueError("excitation: a floating-base model has no joint limits to excite against; "
                          "use a fixed-base model")
+    if np.any(model.joint_type == SPHERICAL):
+        raise ValueError("excitation: Fourier trajectories drive joints of one dof; this model has a spherical joint")
     nv = model.nv
     lo, hi = model.lower.copy(), model.upper.copy()
     bounded = np.isfinite(lo) & np.isfinite(hi)

@@ -13,7 +13,8 @@ acceleration        ``[pddot (world), omegadot (body)]``          ``d/dt [R^T pd
 generalized force   ``[f (world), n (body)]``                     ``[R^T f, n]`` (body)
 =================== ============================================= ===============================
 
-So ``v = T qvel`` with ``T = diag(R^T, 1)`` on each free joint (``R`` the body's rotation),
+Ball joints (robodyn's spherical joints) differ only in the quaternion order: their velocity
+is the angular velocity in the body frame in both. So ``v = T qvel`` with ``T = diag(R^T, 1)`` on each free joint (``R`` the body's rotation),
 ``a = T qacc - [omega x R^T pdot; 0]``, and the mass matrices and bias forces relate as
 ``M_mujoco = T^T M T``, ``qfrc = T^T tau``. Arrays may carry leading batch dimensions.
 
@@ -32,6 +33,12 @@ from ..lie import quat_matrix
 from ..model import Model
 
 __all__ = ["force_to_qfrc", "q_to_qpos", "qacc_to_a", "qfrc_to_force", "qpos_to_q", "qvel_to_v", "v_to_qvel"]
+
+
+def _quaternions(model: Model):
+    """Where the quaternion of every free and ball (spherical) joint starts in ``q``."""
+    return [int(model.idx_q[i] + J.QUAT_OFFSET[model.joint_type[i]]) for i in range(model.nbodies)
+            if J.QUAT_OFFSET[model.joint_type[i]] >= 0]
 
 
 def _free(model: Model):
@@ -54,16 +61,16 @@ def _rotation(q: np.ndarray, iq: int) -> np.ndarray:
 def qpos_to_q(model: Model, qpos) -> np.ndarray:
     """robodyn configuration (..., nq) from MuJoCo's ``qpos`` (quaternions reordered)."""
     q = _array(qpos, model.nq, "qpos")
-    for iq, _ in _free(model):
-        q[..., iq + 3:iq + 7] = np.roll(q[..., iq + 3:iq + 7], -1, axis=-1)
+    for k in _quaternions(model):
+        q[..., k:k + 4] = np.roll(q[..., k:k + 4], -1, axis=-1)
     return q
 
 
 def q_to_qpos(model: Model, q) -> np.ndarray:
     """MuJoCo's ``qpos`` (..., nq) from a robodyn configuration."""
     qpos = _array(q, model.nq, "q")
-    for iq, _ in _free(model):
-        qpos[..., iq + 3:iq + 7] = np.roll(qpos[..., iq + 3:iq + 7], 1, axis=-1)
+    for k in _quaternions(model):
+        qpos[..., k:k + 4] = np.roll(qpos[..., k:k + 4], 1, axis=-1)
     return qpos
 
 

@@ -58,7 +58,7 @@ _CONTINUOUS = ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModel
 _PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 # Pinocchio joint type -> robodyn joint type
 _FROM_PIN = {**dict.fromkeys(_REVOLUTE + _CONTINUOUS, J.REVOLUTE), **dict.fromkeys(_PRISMATIC, J.PRISMATIC),
-             "JointModelFreeFlyer": J.FREE}
+             "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL}
 
 # Symmetric per-dof bounds: robodyn field, Pinocchio's name (the upper bound in Pinocchio >= 4),
 # and the suffix of Pinocchio >= 4's separate lower bound ("lower" + suffix).
@@ -102,6 +102,8 @@ def _check_depth_first(model: Model) -> None:
 def _pin_joint(pin, jtype: int, axis: np.ndarray):
     if jtype == J.FREE:
         return pin.JointModelFreeFlyer()
+    if jtype == J.SPHERICAL:
+        return pin.JointModelSpherical()
     aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
                J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}[jtype]
     k = int(np.argmax(np.abs(axis)))
@@ -157,7 +159,7 @@ def to_pinocchio(model: Model):
                           pin.FrameType.BODY)
         pm.addFrame(frame, False)
 
-    one_dof = model.joint_type != J.FREE  # free joints keep Pinocchio's default (unbounded) limits
+    one_dof = J.QUAT_OFFSET[model.joint_type] < 0  # free and spherical joints keep Pinocchio's default limits
     lower, upper = pm.lowerPositionLimit.copy(), pm.upperPositionLimit.copy()
     lower[model.idx_q[one_dof]] = _to_pin_bound(model.lower[model.idx_v[one_dof]])
     upper[model.idx_q[one_dof]] = _to_pin_bound(model.upper[model.idx_v[one_dof]])
@@ -195,6 +197,8 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray]:
         if pm.parents[j] != 0:
             raise ModelError(f"{source}: joint {name!r} is a JointModelFreeFlyer below joint "
                              f"{pm.names[pm.parents[j]]!r}; robodyn's free joint must attach to the world")
+        return jtype, np.zeros(3)
+    if jtype == J.SPHERICAL:
         return jtype, np.zeros(3)
     S = np.asarray(jm.createData().S, dtype=float).reshape(6)  # constant, [linear; angular]
     return jtype, (S[3:] if jtype == J.REVOLUTE else S[:3])

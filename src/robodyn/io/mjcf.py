@@ -6,7 +6,9 @@ Reads what a robot description uses, with MuJoCo's own rules (its compiler, ``us
   is ``pos`` and one of ``quat`` (w x y z), ``axisangle``, ``euler`` (``<compiler eulerseq>``:
   lower case axes rotate with the frame, upper case stay fixed), ``xyaxes``, ``zaxis``; angles
   in ``<compiler angle>`` units (degrees unless ``radian``).
-- joints ``hinge``, ``slide`` and ``free`` (``<freejoint>`` too), with ``pos``, ``axis``,
+- joints ``hinge``, ``slide``, ``ball`` (a spherical joint: ``q`` is MuJoCo's quaternion
+  reordered, ``v`` its angular velocity in the body frame) and ``free`` (``<freejoint>``
+  too), with ``pos``, ``axis``,
   ``ref``, ``range`` (``limited`` true/false/auto with ``<compiler autolimits>``),
   ``armature``, ``damping`` and ``frictionloss`` (Coulomb friction). Several joints in one
   body become a chain of massless bodies named ``body:joint``, the last one named after the
@@ -24,8 +26,8 @@ Reads what a robot description uses, with MuJoCo's own rules (its compiler, ``us
   (relative to the main file's folder), ``<option gravity>`` and its gravity flag, named
   ``<site>`` elements as frames (``site:name`` where a body already has the name).
 
-Refused with a :class:`~robodyn.model.ModelError` naming the file, element and line: ball
-joints (the spherical joint type is not in robodyn yet), inertia from mesh, height-field or
+Refused with a :class:`~robodyn.model.ModelError` naming the file, element and line: inertia
+from mesh, height-field or
 SDF geoms (give the body an ``<inertial>``), shell inertia, elements that generate bodies
 (``<composite>``, ``<flexcomp>``, ``<replicate>``, ``<attach>``), global coordinates, a free
 joint below a moving body. Ignored with one :class:`~robodyn.errors.RobodynWarning` listing
@@ -438,9 +440,7 @@ class _Bodies:
             jname = ja.get("name") or f"joint{self.njoint}"
             jtype = ja.get("type", "hinge")
             where = doc.where(j)
-            if jtype == "ball":
-                raise ModelError(f"{where}: ball joints are not supported yet (no spherical joint type)")
-            if jtype not in ("hinge", "slide", "free"):
+            if jtype not in ("hinge", "slide", "ball", "free"):
                 raise ModelError(f"{where}: unknown joint type {jtype!r}")
             child = name if k == len(joints) - 1 else f"{name}:{jname}"
             if jtype == "free":
@@ -452,6 +452,13 @@ class _Bodies:
                 self.joints.append((jname, "free", link, child, np.zeros(3), np.eye(3), np.zeros(3),
                                     self.joint_options(j, ja, jtype), where))
                 frame = (np.eye(3), np.zeros(3))
+            elif jtype == "ball":  # F Trans(p) Rot(quat) Trans(-p)
+                anchor = doc.floats(j, ja, "pos", 3, (0.0, 0.0, 0.0))
+                place = _compose(frame, (np.eye(3), anchor))
+                self.links.append(_Link(child, where=doc.where(elem)))
+                self.joints.append((jname, "spherical", link, child, place[1], place[0], np.zeros(3),
+                                    self.joint_options(j, ja, jtype), where))
+                frame = (np.eye(3), -anchor)
             else:
                 axis = doc.floats(j, ja, "axis", 3, (0.0, 0.0, 1.0))
                 if np.linalg.norm(axis) < _EPS:
@@ -483,8 +490,8 @@ class _Bodies:
         out = {}
         for key, field in (("armature", "armature"), ("damping", "damping"), ("frictionloss", "friction")):
             out[field] = doc.number(elem, a, key, 0.0)
-        if jtype == "free":
-            return out
+        if jtype in ("free", "ball"):
+            return out  # a ball joint's range is a cone: not a box on the dofs
         limited = doc.flag(elem, a, "limited", "auto", ("true", "false", "auto"))
         if limited == "true" or (limited == "auto" and self.c.autolimits and "range" in a):
             lo, hi = doc.floats(elem, a, "range", 2, (0.0, 0.0)) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)

@@ -22,22 +22,12 @@ import numpy as np
 
 from .. import joints as J
 
-_FREE_Q = ("x", "y", "z", "qx", "qy", "qz", "qw")
-_FREE_V = ("vx", "vy", "vz", "wx", "wy", "wz")
 
 
 def coordinate_names(model) -> tuple[list[str], list[str]]:
     """Names of the entries of ``q`` (nq) and of ``v`` (nv), in order."""
-    qn, vn = [], []
-    for i in range(model.nbodies):
-        name = model.body_joint_names[i]
-        if model.joint_type[i] == J.FREE:
-            qn += [f"{name}:{c}" for c in _FREE_Q]
-            vn += [f"{name}:{c}" for c in _FREE_V]
-        else:
-            qn.append(name)
-            vn.append(name)
-    return qn, vn
+    return (J.coordinate_names(model.joint_type, model.body_joint_names, "q", ":"),
+            J.coordinate_names(model.joint_type, model.body_joint_names, "v", ":"))
 
 
 def read_csv(model, path):

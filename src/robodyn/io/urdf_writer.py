@@ -6,7 +6,9 @@ joint without position limits), or prismatic joint with its placement (``rpy`` e
 X-Y-Z, ``R = Rz Ry Rx``), axis, ``<limit>`` and ``<dynamics damping friction>``. Frames (links
 merged into bodies) become mass-less links on fixed joints. A fixed base's root link keeps
 its name (the model's frame attached to the world); a floating base's root link is body 0,
-and the file must be loaded with ``floating_base=True``. Numbers are written with ``repr``
+and the file must be loaded with ``floating_base=True``. Other free joints (bodies flying
+beside a fixed base) become ``floating`` joints under the root link. Spherical joints, and free
+joints beside a floating base, raise ``ValueError``. Numbers are written with ``repr``
 (exact round trip).
 
 What URDF cannot hold is reported with a :class:`RobodynWarning`: armature, Coulomb
@@ -92,7 +94,18 @@ def write_urdf(model, path=None) -> str:
     joint_names = set(model.body_joint_names)
     for i in range(model.nbodies):
         jt = model.joint_type[i]
-        if jt == J.FREE:
+        if jt == J.SPHERICAL:
+            raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} is spherical, which URDF cannot express")
+        if jt == J.FREE and i == 0 and floating:
+            continue
+        if jt == J.FREE:  # another free body: a floating joint under the fixed world
+            if floating:
+                raise ValueError(f"write_urdf: free joint {model.body_joint_names[i]!r} beside a floating base, "
+                                 "which URDF cannot express (one tree from one root link)")
+            lines += [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
+                      f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"floating\">",
+                      f"    <parent link={quoteattr(root)}/>", f"    <child link={quoteattr(model.link_names[i])}/>",
+                      f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}", "  </joint>"]
             continue
         k = model.idx_v[i]
         lo, hi = model.lower[k], model.upper[k]

@@ -25,7 +25,7 @@ from ..control.laws import law_torque
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..joints import FREE
+from ..joints import FREE, SPHERICAL
 from ..spatial import rotation_from_quaternion
 
 SEMI_IMPLICIT_EULER = 0
@@ -36,22 +36,25 @@ def chart_point(ints, q0, theta, q):
     """``q = q0 ⊞ theta`` (see the module docstring)."""
     for i in range(ints.shape[0]):
         jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
-        if jt != FREE:
+        if jt != FREE and jt != SPHERICAL:
             q[iq] = q0[iq] + theta[iv]
             continue
-        for r in range(3):
-            q[iq + r] = q0[iq + r] + theta[iv + r]
-        wx, wy, wz = theta[iv + 3], theta[iv + 4], theta[iv + 5]
+        k, o = iq, iv  # the quaternion in q, the rotation vector in theta
+        if jt == FREE:
+            for r in range(3):
+                q[iq + r] = q0[iq + r] + theta[iv + r]
+            k, o = iq + 3, iv + 3
+        wx, wy, wz = theta[o], theta[o + 1], theta[o + 2]
         t = np.sqrt(wx * wx + wy * wy + wz * wz)
         s = 0.5 - t * t / 48.0 if t < 1e-4 else np.sin(0.5 * t) / t
         bx, by, bz, bw = s * wx, s * wy, s * wz, np.cos(0.5 * t)
-        ax, ay, az, aw = q0[iq + 3], q0[iq + 4], q0[iq + 5], q0[iq + 6]
+        ax, ay, az, aw = q0[k], q0[k + 1], q0[k + 2], q0[k + 3]
         x = aw * bx + bw * ax + ay * bz - az * by
         y = aw * by + bw * ay + az * bx - ax * bz
         z = aw * bz + bw * az + ax * by - ay * bx
         w = aw * bw - ax * bx - ay * by - az * bz
         n = np.sqrt(x * x + y * y + z * z + w * w)
-        q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6] = x / n, y / n, z / n, w / n
+        q[k], q[k + 1], q[k + 2], q[k + 3] = x / n, y / n, z / n, w / n
 
 
 @inline
@@ -59,20 +62,23 @@ def chart_rate(ints, q, theta, v, R, out):
     """``out = d theta / dt`` for velocity ``v`` at ``q = q0 ⊞ theta``; ``R`` is 3 x 3 workspace."""
     for i in range(ints.shape[0]):
         jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
-        if jt != FREE:
+        if jt != FREE and jt != SPHERICAL:
             out[iv] = v[iv]
             continue
-        rotation_from_quaternion(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6], R)
-        for r in range(3):
-            out[iv + r] = R[r, 0] * v[iv] + R[r, 1] * v[iv + 1] + R[r, 2] * v[iv + 2]
-        px, py, pz = theta[iv + 3], theta[iv + 4], theta[iv + 5]
-        wx, wy, wz = v[iv + 3], v[iv + 4], v[iv + 5]
+        o = iv
+        if jt == FREE:
+            rotation_from_quaternion(q[iq + 3], q[iq + 4], q[iq + 5], q[iq + 6], R)
+            for r in range(3):
+                out[iv + r] = R[r, 0] * v[iv] + R[r, 1] * v[iv + 1] + R[r, 2] * v[iv + 2]
+            o = iv + 3
+        px, py, pz = theta[o], theta[o + 1], theta[o + 2]
+        wx, wy, wz = v[o], v[o + 1], v[o + 2]
         t = np.sqrt(px * px + py * py + pz * pz)
         c = 1.0 / 12.0 + t * t / 720.0 if t < 1e-3 else (1.0 - 0.5 * t * np.cos(0.5 * t) / np.sin(0.5 * t)) / (t * t)
         ux, uy, uz = py * wz - pz * wy, pz * wx - px * wz, px * wy - py * wx  # phi x omega
-        out[iv + 3] = wx + 0.5 * ux + c * (py * uz - pz * uy)
-        out[iv + 4] = wy + 0.5 * uy + c * (pz * ux - px * uz)
-        out[iv + 5] = wz + 0.5 * uz + c * (px * uy - py * ux)
+        out[o] = wx + 0.5 * ux + c * (py * uz - pz * uy)
+        out[o + 1] = wy + 0.5 * uy + c * (pz * ux - px * uz)
+        out[o + 2] = wz + 0.5 * uz + c * (px * uy - py * ux)
 
 
 @inline

@@ -68,35 +68,37 @@ def _chart(model, q0, theta, v):
     Dq0, Dth, Kv = eye.copy(), eye.copy(), eye.copy()
     Kq, Kth = np.zeros_like(Dq0), np.zeros_like(Dq0)
     q, k = q0.copy(), v.copy()
-    one = model.joint_type != J.FREE
+    one = J.QUAT_OFFSET[model.joint_type] < 0
     q[..., model.idx_q[one]] += theta[..., model.idx_v[one]]
-    for i in np.flatnonzero(~one):
+    for i in np.flatnonzero(~one):  # free and spherical joints: a rotation (and a translation)
+        free = model.joint_type[i] == J.FREE
         iq, iv = model.idx_q[i], model.idx_v[i]
-        lin, ang = slice(iv, iv + 3), slice(iv + 3, iv + 6)
-        phi, w, vl = theta[..., ang], v[..., ang], v[..., lin]
-        quat = quat_mul(q0[..., iq + 3:iq + 7], exp_se3(np.concatenate([np.zeros_like(phi), phi], -1))[0])
+        kq, ang = (iq + 3, slice(iv + 3, iv + 6)) if free else (iq, slice(iv, iv + 3))
+        phi, w = theta[..., ang], v[..., ang]
+        quat = quat_mul(q0[..., kq:kq + 4], exp_se3(np.concatenate([np.zeros_like(phi), phi], -1))[0])
         quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
-        q[..., iq:iq + 3] = q0[..., iq:iq + 3] + theta[..., lin]
-        q[..., iq + 3:iq + 7] = quat
+        q[..., kq:kq + 4] = quat
         R, E, Jr = quat_matrix(quat), exp_so3(phi), right_jacobian_so3(phi)
         Et, P, W = np.swapaxes(E, -1, -2), skew(phi), skew(w)
         t = np.linalg.norm(phi, axis=-1)
         c, dc = inverse_jacobian_coefficients(t)
         c, dc = c[..., None, None], dc[..., None, None]
         Jr_inv = np.eye(3) + 0.5 * P + c * (P @ P)
-        k[..., lin] = np.einsum("...ij,...j->...i", R, vl)
         k[..., ang] = np.einsum("...ij,...j->...i", Jr_inv, w)
-        RV = R @ skew(vl)
         ppw = (P @ P @ w[..., None])  # phi x (phi x w), (..., 3, 1)
         pw = np.sum(phi * w, -1)[..., None, None]
-        Dq0[..., lin, lin], Dq0[..., ang, ang] = Et, Et
-        Dth[..., lin, lin], Dth[..., ang, ang] = np.swapaxes(R, -1, -2), Jr
-        Kv[..., lin, lin], Kv[..., ang, ang] = R, Jr_inv
-        Kq[..., lin, ang] = -RV @ Et
-        Kth[..., lin, ang] = -RV @ Jr
+        Dq0[..., ang, ang], Dth[..., ang, ang], Kv[..., ang, ang] = Et, Jr, Jr_inv
         Kth[..., ang, ang] = (-0.5 * W + c * (pw * np.eye(3) + phi[..., :, None] * w[..., None, :]
                                               - 2.0 * w[..., :, None] * phi[..., None, :])
                               + dc * ppw * phi[..., None, :])
+        if free:
+            lin, vl = slice(iv, iv + 3), v[..., iv:iv + 3]
+            q[..., iq:iq + 3] = q0[..., iq:iq + 3] + theta[..., lin]
+            k[..., lin] = np.einsum("...ij,...j->...i", R, vl)
+            RV = R @ skew(vl)
+            Dq0[..., lin, lin], Dth[..., lin, lin], Kv[..., lin, lin] = Et, np.swapaxes(R, -1, -2), R
+            Kq[..., lin, ang] = -RV @ Et
+            Kth[..., lin, ang] = -RV @ Jr
     return q, k, Dq0, Dth, Kq, Kth, Kv
 
 
