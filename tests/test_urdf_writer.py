@@ -84,3 +84,32 @@ def test_what_urdf_cannot_hold():
     lower[2] = -np.inf
     with pytest.raises(ValueError, match="one-sided position limit"):
         rd.write_urdf(model.replace(armature=np.zeros(6), lower=lower))
+
+
+def test_free_bodies_beside_a_fixed_base_round_trip_as_floating_joints():
+    """Bodies on free joints beside a fixed tree (a MuJoCo scene, say) become URDF floating
+    joints under the root link and load back as free joints; beside a floating base, and for
+    spherical joints, URDF has no way: ValueError."""
+    b = rd.ModelBuilder("scene")
+    b.add_link("world")
+    b.add_link("arm", mass=1.0, com=(0.1, 0, 0), inertia=np.diag([0.01, 0.02, 0.02]))
+    b.add_joint("shoulder", "revolute", "world", "arm", axis=(0, 0, 1), xyz=(0, 0, 0.5))
+    b.add_link("box", mass=2.0, com=(0, 0.1, 0), inertia=np.diag([0.03, 0.02, 0.04]))
+    b.add_joint("box_free", "free", "world", "box", xyz=(1, 0, 0), rpy=(0.1, 0.2, 0.3))
+    model = b.build()
+    text = rd.write_urdf(model)
+    assert 'type="floating"' in text
+    back = rd.load_urdf(text)
+    pq, pv = _permutations(model, back)
+    q, v, a = states(model, "scene", size=2)
+    assert_rel(rd.rnea(back, q[:, pq], v[:, pv], a[:, pv]), rd.rnea(model, q, v, a)[:, pv], 1e-12)
+    b2 = rd.ModelBuilder("two")
+    b2.add_link("a", mass=1.0, inertia=np.eye(3) * 0.01)
+    b2.add_link("world")
+    b2.add_link("b", mass=1.0, inertia=np.eye(3) * 0.01)
+    b2.add_joint("fa", "free", "world", "a")
+    b2.add_joint("fb", "free", "world", "b")
+    two = b2.build()
+    assert two.floating_base and two.nv == 12
+    with pytest.raises(ValueError, match="free joint 'fb' beside a floating base"):
+        rd.write_urdf(two)
