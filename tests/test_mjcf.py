@@ -100,9 +100,15 @@ def _full_mass_matrix(mm, d) -> np.ndarray:
     return M
 
 
-def compare_with_mujoco(model: rd.Model, mm, states: int = 3, seed: int = 0) -> None:
-    """Mass matrix, bias forces, inverse dynamics (joint damping included) and site frames of
-    ``model`` against MuJoCo's ``mm`` at random states, through the interop conversions."""
+def loader_label(model: rd.Model, site: str) -> str:
+    """The frame ``load_mjcf`` makes of a MuJoCo site (``site:name`` where a body has the name)."""
+    return f"site:{site}" if f"site:{site}" in model.frame_names else site
+
+
+def compare_with_mujoco(model: rd.Model, mm, states: int = 3, seed: int = 0, label=loader_label) -> None:
+    """Mass matrix, bias forces, inverse dynamics (joint damping included) and site frames
+    (``label(model, site)`` names the frame of a site) of ``model`` against MuJoCo's ``mm`` at
+    random states, through the interop conversions."""
     assert (model.nq, model.nv) == (mm.nq, mm.nv)
     moving = mm.body_dofnum[mm.body_weldid] > 0  # bodies welded to the world or mocap: no dynamics
     np.testing.assert_allclose(model.total_mass, mm.body_mass[moving].sum(), rtol=1e-12)
@@ -136,8 +142,7 @@ def compare_with_mujoco(model: rd.Model, mm, states: int = 3, seed: int = 0) -> 
         for k in range(mm.nsite):
             name = mujoco.mj_id2name(mm, mujoco.mjtObj.mjOBJ_SITE, k)
             if name:
-                label = f"site:{name}" if f"site:{name}" in model.frame_names else name
-                pose = rd.frame_pose(model, q, label)
+                pose = rd.frame_pose(model, q, label(model, name))
                 np.testing.assert_allclose(pose[:3, 3], d.site_xpos[k], rtol=1e-12, atol=1e-12)
                 np.testing.assert_allclose(pose[:3, :3], d.site_xmat[k].reshape(3, 3), rtol=1e-12, atol=1e-12)
         if not model.nv:

@@ -8,7 +8,7 @@
 """
 
 from .builder import ModelBuilder
-from .io import DHLink, dh_transform, from_dh, load_mjcf, load_urdf, write_urdf
+from .io import DHLink, dh_transform, from_dh, load_mjcf, load_urdf, write_mjcf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
@@ -73,7 +73,7 @@ __all__ = [
     "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
-    "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf",
+    "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf", "write_mjcf",
     "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
     "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",

@@ -58,6 +58,14 @@ def inertia_about_origin(theta) -> np.ndarray:
     return np.array([[t[4], t[5], t[7]], [t[5], t[6], t[8]], [t[7], t[8], t[9]]], dtype=float)
 
 
+def mass_com_inertia(theta) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(m, c, I_c)`` of 10 inertial parameters: mass, centre of mass and inertia about it
+    (zero centre of mass for a massless body)."""
+    m = float(theta[0])
+    c = np.asarray(theta[1:4], dtype=float) / m if m > 0 else np.zeros(3)
+    return m, c, inertia_about_origin(theta) - m * (c @ c * np.eye(3) - np.outer(c, c))
+
+
 def inertial_parameters_in_parent(R, p, theta) -> np.ndarray:
     """Inertial parameters of a body expressed in the frame where it is placed at ``(R, p)``.
 

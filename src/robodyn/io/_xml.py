@@ -12,6 +12,7 @@ import os
 import re
 from pathlib import Path
 
+import numpy as np
 from defusedxml import DefusedXmlException, DTDForbidden
 from defusedxml.ElementTree import DefusedXMLParser, ParseError
 
@@ -178,6 +179,11 @@ def _parse(text: str, name: str):
     except RecursionError:
         raise ModelError(f"{name}: XML nested too deeply") from None
     return root, parser.lines
+
+
+def numbers(x) -> str:
+    """Numbers as XML attribute text, exactly (``repr`` of each float, space separated)."""
+    return " ".join(repr(float(v)) for v in np.atleast_1d(x))
 
 
 def local_name(tag) -> str | None:

@@ -27,10 +27,11 @@ import numpy as np
 from ..files import write_text
 from .. import joints as J
 from ..errors import RobodynWarning
+from ..model import mass_com_inertia
+from ._xml import numbers
 
 
-def _num(x) -> str:
-    return " ".join(repr(float(v)) for v in np.atleast_1d(x))
+_num = numbers
 
 
 def _origin(R, p) -> str:
@@ -54,9 +55,7 @@ def _inertial(theta) -> list[str]:
     m = float(theta[0])
     if m <= 0.0:
         return []
-    c = np.asarray(theta[1:4]) / m
-    Io = np.array([[theta[4], theta[5], theta[7]], [theta[5], theta[6], theta[8]], [theta[7], theta[8], theta[9]]])
-    Ic = Io - m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
+    m, c, Ic = mass_com_inertia(theta)
     return ["    <inertial>",
             f'      <origin xyz="{_num(c)}" rpy="0.0 0.0 0.0"/>',
             f'      <mass value="{_num(m)}"/>',
