@@ -70,6 +70,18 @@ def workspace(nb, nv):
 
 
 @inline
+def add_unshifted(shift, f, p):
+    """``p += iX_p^T f``: the force ``f`` (a 6-tuple) moved by ``shift`` to the parent's origin."""
+    f0, f1, f2, n0, n1, n2 = unshifted_force(shift, f)
+    p[0] += f0
+    p[1] += f1
+    p[2] += f2
+    p[3] += n0
+    p[4] += n1
+    p[5] += n2
+
+
+@inline
 def bias_forces_one_dof(k, end, d, S, UD, F_i, F_p, Minv):
     """Pass 2 of a body whose joint has the one dof ``k`` (every body but a root), with the
     joint's vectors and the shift held in registers (read from the workspace, which every
@@ -82,15 +94,8 @@ def bias_forces_one_dof(k, end, d, S, UD, F_i, F_p, Minv):
         f = F_i[col]
         u = (1.0 if col == k else 0.0) - (s0 * f[0] + s1 * f[1] + s2 * f[2] + s3 * f[3] + s4 * f[4] + s5 * f[5])
         Minv[k, col] = u
-        f0, f1, f2, n0, n1, n2 = unshifted_force(
-            shift, (f[0] + g0 * u, f[1] + g1 * u, f[2] + g2 * u, f[3] + g3 * u, f[4] + g4 * u, f[5] + g5 * u))
-        p = F_p[col]
-        p[0] += f0
-        p[1] += f1
-        p[2] += f2
-        p[3] += n0
-        p[4] += n1
-        p[5] += n2
+        add_unshifted(shift, (f[0] + g0 * u, f[1] + g1 * u, f[2] + g2 * u, f[3] + g3 * u, f[4] + g4 * u,
+                              f[5] + g5 * u), F_p[col])
 
 
 @inline
@@ -128,14 +133,7 @@ def bias_forces_dofs(iv, n, end, d, S, UD, F_i, F_p, Minv, t):
             Minv[k, col] = u
             for r in range(6):
                 t[r] += UD[r, j] * u
-        f0, f1, f2, n0, n1, n2 = unshifted_force(shift, (t[0], t[1], t[2], t[3], t[4], t[5]))
-        p = F_p[col]
-        p[0] += f0
-        p[1] += f1
-        p[2] += f2
-        p[3] += n0
-        p[4] += n1
-        p[5] += n2
+        add_unshifted(shift, (t[0], t[1], t[2], t[3], t[4], t[5]), F_p[col])
 
 
 @inline
