@@ -31,7 +31,8 @@ import numpy as np
 
 from . import joints as J
 from .errors import RobodynWarning
-from .model import Model, ModelError, check_inertial_parameters, inertial_parameters_from, inertial_parameters_in_parent
+from .model import (Model, ModelError, check_inertial_parameters, consistent_inertial_parameters,
+                    inertial_parameters_from, inertial_parameters_in_parent)
 
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
                "spherical": J.SPHERICAL, "fixed": None}
@@ -53,7 +54,15 @@ class _Link:
     name: str
     theta: np.ndarray
     where: str
-    issue: str = ""  # why the link alone is not a consistent rigid body (checked after merging)
+
+    def issue(self) -> str:
+        """Why the link alone is not a consistent rigid body ("" if it is); asked only when
+        the body it merges into fails."""
+        try:
+            check_inertial_parameters(self.theta, self.where)
+            return ""
+        except ModelError as e:
+            return str(e)
 
 
 @dataclass
@@ -106,13 +115,7 @@ class ModelBuilder:
             Ic = Rr @ Ic @ Rr.T
         if mass < 0:
             raise ModelError(f"{where}: negative mass {mass}")
-        theta = inertial_parameters_from(mass, com, Ic)
-        try:
-            check_inertial_parameters(theta, where)
-            issue = ""
-        except ModelError as e:
-            issue = str(e)
-        self._links[name] = _Link(name, theta, where, issue)
+        self._links[name] = _Link(name, inertial_parameters_from(mass, com, Ic), where)
 
     def _check_body(self, theta, name: str, links: list[_Link]) -> None:
         """Check the merged body ``name`` (``theta``), made of ``links``; raise (or warn, with
@@ -130,7 +133,8 @@ class ModelBuilder:
             m, h = k.theta[0], k.theta[1:4]
             com = (h / m).round(6).tolist() if m > 0 else "-"
             place = k.where[len(self.source) + 2:] if k.where.startswith(f"{self.source}: ") else k.where
-            alone = k.issue[len(k.where) + 2:] if k.issue and len(links) > 1 else ""
+            issue = k.issue() if len(links) > 1 else ""
+            alone = issue[len(k.where) + 2:] if issue else ""
             parts.append(f"{place}: mass {m:.6g}, com {com}" + (f", alone: {alone}" if alone else ""))
         message += "; made of " + "; ".join(parts)
         if self.physical == "warn":
@@ -282,8 +286,9 @@ class ModelBuilder:
                 continue  # carried by the fixed world
             theta[b] += inertial_parameters_in_parent(R, p, self._links[link].theta)
             members[b].append(self._links[link])
-        for i, t in enumerate(theta):
-            self._check_body(t, names[i], members[i])
+        suspect = ~consistent_inertial_parameters(np.reshape(theta, (-1, 10))) if theta else []
+        for i in np.flatnonzero(suspect):
+            self._check_body(theta[i], names[i], members[i])
 
         def col(key):
             return np.array([d[key] for d in dofs], dtype=float)

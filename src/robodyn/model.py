@@ -117,6 +117,27 @@ def check_inertial_parameters(theta, where: str) -> None:
         )
 
 
+def consistent_inertial_parameters(theta) -> np.ndarray:
+    """:func:`check_inertial_parameters` of many bodies at once, ``theta`` (n, 10): a boolean
+    (n,) mask, True where the body passes (the same tests and tolerances)."""
+    theta = np.asarray(theta, dtype=float).reshape(-1, 10)
+    n = theta.shape[0]
+    ok = np.isfinite(theta).all(1)
+    t = np.where(ok[:, None], theta, 0.0)
+    m = t[:, 0]
+    Io = t[:, [4, 5, 7, 5, 6, 8, 7, 8, 9]].reshape(n, 3, 3)
+    scale = np.maximum(np.abs(Io).reshape(n, 9).max(1, initial=0.0), 1e-300)
+    massless = m == 0
+    ok &= (m >= 0) & ~(massless & (np.abs(t[:, 1:]).max(1, initial=0.0) > 0))
+    ms = np.where(massless, 1.0, m)
+    c = t[:, 1:4] / ms[:, None]
+    Ic = Io - ms[:, None, None] * (np.einsum("ni,ni->n", c, c)[:, None, None] * np.eye(3) - c[:, :, None] * c[:, None, :])
+    eig = np.linalg.eigvalsh(Ic) if n else np.zeros((0, 3))
+    tol = np.maximum(np.maximum(INERTIA_RTOL * np.abs(eig).max(1, initial=0.0), 1e-12 * scale), INERTIA_ATOL)
+    rigid = (eig[:, 0] >= -tol) & (eig[:, 0] + eig[:, 1] >= eig[:, 2] - tol)
+    return ok & (massless | rigid)
+
+
 class Model:
     """Immutable rigid-body tree (see the module docstring for the layout).
 
@@ -199,22 +220,32 @@ class Model:
         jnames = list(body_joint_names)
         if len(names) != nb or len(jnames) != nb:
             raise ModelError(f"link_names and body_joint_names need {nb} entries")
-        for i in range(nb):
+        # every body checked at once; the bodies that fail are checked again one by one, in
+        # order, for the message
+        finite = np.isfinite(axis).all(1) & np.isfinite(R).reshape(nb, 9).all(1) & np.isfinite(p).all(1)
+        one_dof = (jt == J.REVOLUTE) | (jt == J.PRISMATIC)
+        norms = np.linalg.norm(np.where(finite[:, None], axis, 0.0), axis=1)
+        Rf = np.where(finite[:, None, None], R, np.eye(3))
+        rotation = ((np.abs(Rf @ Rf.transpose(0, 2, 1) - np.eye(3)).reshape(nb, 9).max(1, initial=0.0) <= 1e-9)
+                    & (np.linalg.det(Rf) >= 0)) if nb else np.ones(0, bool)
+        if physical == "error":
+            inertial = consistent_inertial_parameters(theta)
+        else:
+            inertial = np.isfinite(theta).all(1) & (theta[:, 0] >= 0)
+        for i in np.flatnonzero(~finite | (one_dof & ~(norms >= 1e-12)) | ~rotation | ~inertial):
             where = f"body {i} ({names[i]!r})"
             for what, a in (("joint_axis", axis[i]), ("X_tree_R", R[i]), ("X_tree_p", p[i])):
                 if not np.all(np.isfinite(a)):
                     raise ModelError(f"{where}: {what} is not finite")
-            if jt[i] in (J.REVOLUTE, J.PRISMATIC):
-                n = np.linalg.norm(axis[i])
-                if n < 1e-12:
-                    raise ModelError(f"{where}: joint axis is zero")
-                axis[i] = axis[i] / n
+            if one_dof[i] and np.linalg.norm(axis[i]) < 1e-12:
+                raise ModelError(f"{where}: joint axis is zero")
             if np.abs(R[i] @ R[i].T - np.eye(3)).max() > 1e-9 or np.linalg.det(R[i]) < 0:
                 raise ModelError(f"{where}: X_tree_R is not a rotation matrix")
             if physical == "error":
                 check_inertial_parameters(theta[i], where)
             elif not (np.all(np.isfinite(theta[i])) and theta[i, 0] >= 0):
                 raise ModelError(f"{where}: inertial parameters must be finite with mass >= 0")
+        axis[one_dof] = axis[one_dof] / norms[one_dof, None]
         g = arr(gravity, (3,), "gravity")
         if not np.all(np.isfinite(g)):
             raise ModelError("gravity is not finite")

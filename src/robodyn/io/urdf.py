@@ -23,6 +23,7 @@ Files are limited to ``MAX_FILE_BYTES`` bytes and ``MAX_DEPTH`` levels of nestin
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections import Counter
 
@@ -42,6 +43,14 @@ def _read_source(source) -> tuple[str, str]:
     return read_source(source, "URDF", MAX_FILE_BYTES)
 
 
+def _child(elem, tag: str):
+    """The first child ``<tag>`` of ``elem`` (``Element.find`` without its path machinery)."""
+    for c in elem:
+        if c.tag == tag:
+            return c
+    return None
+
+
 class _Reader:
     def __init__(self, name: str, lines: dict[int, int]):
         self.name = name
@@ -58,21 +67,21 @@ class _Reader:
                 raise ModelError(f"{self.where(elem)}: missing attribute {attr!r}")
             return np.asarray(default, dtype=float)
         try:
-            vals = np.array([float(t) for t in raw.split()], dtype=float)
+            vals = [float(t) for t in raw.split()]
         except ValueError:
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} is not {n} number(s)") from None
-        if vals.shape != (n,):
+        if len(vals) != n:
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} needs {n} number(s)")
-        if not np.all(np.isfinite(vals)):
+        if not all(map(math.isfinite, vals)):
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} is not finite")
-        return vals
+        return np.array(vals)
 
     def origin(self, parent):
-        o = parent.find("origin")
+        o = _child(parent, "origin")
         return self.floats(o, "xyz", 3, (0, 0, 0)), self.floats(o, "rpy", 3, (0, 0, 0))
 
     def required_child(self, elem, tag: str, attr: str) -> str:
-        c = elem.find(tag)
+        c = _child(elem, tag)
         if c is None or c.get(attr) is None:
             raise ModelError(f"{self.where(elem)}: missing <{tag} {attr}=...>")
         return c.get(attr)
@@ -111,10 +120,10 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
             joint_elems.append(elem)
         else:
             ignored[elem.tag] += 1
-    if root.find("link") is None:
+    if _child(root, "link") is None:
         raise ModelError(f"{rd.where(root)}: no <link> element")
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
-        if elem.find("mimic") is not None:
+        if _child(elem, "mimic") is not None:
             mimic.append(elem.get("name"))
         _read_joint(rd, b, elem, ignored, reversed_limits)
     if reversed_limits:
@@ -138,7 +147,7 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     for child in elem:
         if isinstance(child.tag, str) and child.tag != "inertial":
             ignored[child.tag] += 1
-    inertials = elem.findall("inertial")
+    inertials = [c for c in elem if c.tag == "inertial"]
     if len(inertials) > 1:
         raise ModelError(f"{rd.where(elem)}: more than one <inertial>")
     if not inertials:
@@ -147,11 +156,11 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     inertial = inertials[0]
     where = rd.where(inertial, f"<link name={lname!r}> <inertial>")
     xyz, rpy = rd.origin(inertial)
-    mass_el = inertial.find("mass")
+    mass_el = _child(inertial, "mass")
     if mass_el is None:
         raise ModelError(f"{where}: missing <mass value=...>")
     mass = rd.floats(mass_el, "value", 1)[0]
-    I_el = inertial.find("inertia")
+    I_el = _child(inertial, "inertia")
     if I_el is None:
         I = np.zeros((3, 3))
     else:
@@ -181,9 +190,9 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
     parent = rd.required_child(elem, "parent", "link")
     child = rd.required_child(elem, "child", "link")
     xyz, rpy = rd.origin(elem)
-    axis = rd.floats(elem.find("axis"), "xyz", 3, (1.0, 0.0, 0.0))
-    lim = elem.find("limit")
-    dyn = elem.find("dynamics")
+    axis = rd.floats(_child(elem, "axis"), "xyz", 3, (1.0, 0.0, 0.0))
+    lim = _child(elem, "limit")
+    dyn = _child(elem, "dynamics")
     kw = {}
     if lim is not None:
         # URDF: lower and upper default to 0 in a <limit> (urdfdom and Pinocchio read it so);
