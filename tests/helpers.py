@@ -29,17 +29,17 @@ from robodyn.random import random_model, random_state
 G = 9.81
 
 # (bodies, seed, floating base, branching, joint types): chains, branches, 1..15 bodies, both
-# base types; revolute and prismatic joints, and spherical joints mixed in (ids "-sph")
+# base types; revolute and prismatic joints, and spherical and helical joints mixed in (ids "-mixed")
 ONE_DOF = (J.REVOLUTE, J.PRISMATIC)
-MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL)
+MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL)
 RANDOM_CASES = [
     (1, 0, False, 0.3, ONE_DOF), (1, 1, True, 0.3, ONE_DOF), (2, 2, False, 0.5, ONE_DOF), (3, 3, True, 0.9, ONE_DOF),
     (5, 4, False, 0.7, ONE_DOF), (7, 5, True, 0.3, ONE_DOF), (10, 6, False, 0.0, ONE_DOF), (12, 7, True, 0.5, ONE_DOF),
-    (15, 8, False, 0.9, ONE_DOF), (15, 9, True, 0.3, ONE_DOF), (6, 11, False, 0.4, MIXED), (8, 10, True, 0.5, MIXED),
+    (15, 8, False, 0.9, ONE_DOF), (15, 9, True, 0.3, ONE_DOF), (6, 11, False, 0.4, MIXED), (8, 16, True, 0.5, MIXED),
 ]
 RANDOM_MODELS = [random_model(n, seed=s, floating_base=fb, branching=b, joint_types=jt)
                  for n, s, fb, b, jt in RANDOM_CASES]
-RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}{'-sph' if J.SPHERICAL in jt else ''}"
+RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}{'-mixed' if J.SPHERICAL in jt else ''}"
               for n, s, fb, b, jt in RANDOM_CASES]
 # Models whose velocity is the derivative of the configuration (no free or spherical joint,
 # whose angular velocities are quasi-velocities): identities in coordinates hold on them.

@@ -27,6 +27,7 @@ from helpers import assert_rel, random_state, rng_for, with_friction_and_armatur
 from urdf_subset import SUBSET
 
 import robodyn as rd
+from robodyn import joints as J
 from robodyn.interop import (
     configuration_from_pinocchio,
     configuration_to_pinocchio,
@@ -215,10 +216,21 @@ def test_round_trip_of_a_builtin_model_with_a_massless_body():
 
 
 # (d) errors ----------------------------------------------------------------------------
+def test_aligned_helical_joints_come_in_as_helical_joints():
+    pm = pin.Model()
+    j = pm.addJoint(0, pin.JointModelHZ(0.1), pin.SE3.Identity(), "screw")
+    pm.appendBodyToJoint(j, pin.Inertia.Random(), pin.SE3.Identity())
+    model = from_pinocchio(pm)
+    assert model.joint_type.tolist() == [J.HELICAL] and model.joint_pitch.tolist() == [0.1]
+    np.testing.assert_allclose(model.joint_axis[0], [0, 0, 1])
+    q, v, a = np.array([0.4]), np.array([1.2]), np.array([-0.3])
+    np.testing.assert_allclose(rd.rnea(model, q, v, a), pin.rnea(pm, pm.createData(), q, v, a), rtol=1e-12)
+
+
 @pytest.mark.parametrize("joint, kind", [
     (pin.JointModelSphericalZYX(), "JointModelSphericalZYX"),
     (pin.JointModelPlanar(), "JointModelPlanar"), (pin.JointModelTranslation(), "JointModelTranslation"),
-    (pin.JointModelHZ(0.1), "JointModelHZ"),
+    (pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])), "JointModelUniversal"),
 ])
 def test_unsupported_joint_types_are_named(joint, kind):
     pm = pin.Model()

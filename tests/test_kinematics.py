@@ -30,6 +30,8 @@ def poses_by_hand(model, q):
             R = _rodrigues(axis, q[iq])
         elif model.joint_type[i] == J.PRISMATIC:
             p = axis * q[iq]
+        elif model.joint_type[i] == J.HELICAL:
+            R, p = _rodrigues(axis, q[iq]), model.joint_pitch[i] * q[iq] * axis
         elif model.joint_type[i] == J.SPHERICAL:
             R = quat_to_matrix(q[iq:iq + 4])
         else:

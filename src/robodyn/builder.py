@@ -35,7 +35,7 @@ from .model import (Model, ModelError, check_inertial_parameters, consistent_ine
                     inertial_parameters_from, inertial_parameters_in_parent)
 
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
-               "spherical": J.SPHERICAL, "fixed": None}
+               "spherical": J.SPHERICAL, "helical": J.HELICAL, "fixed": None}
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -76,6 +76,7 @@ class _Joint:
     axis: np.ndarray
     limits: dict = field(default_factory=dict)
     where: str = ""
+    pitch: float = 0.0
 
 
 class ModelBuilder:
@@ -145,11 +146,13 @@ class ModelBuilder:
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
                   upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
-                  armature=0.0, where: str | None = None) -> None:
+                  armature=0.0, pitch: float = 0.0, where: str | None = None) -> None:
         """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
         in the parent link frame and the child frame coincides with it at ``q = 0``.
 
-        ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``fixed``, ``spherical`` (a ball
+        ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``helical`` (a screw: rotation
+        about ``axis`` with a translation ``pitch`` metres per radian along it), ``fixed``,
+        ``spherical`` (a ball
         joint: ``q = [qx, qy, qz, qw]`` rotates the child in the joint frame) or ``free`` (a
         6-dof joint, whose parent link must be the root or welded to it: its configuration
         ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame)."""
@@ -182,7 +185,9 @@ class ModelBuilder:
                 raise ModelError(f"{where}: {k} must be finite and >= 0, got {val}")
         if limits["lower"] > limits["upper"]:
             raise ModelError(f"{where}: lower limit {lower} exceeds upper limit {upper}")
-        self._joints.append(_Joint(name, type, parent, child, R, p, ax, limits, where))
+        if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
+            raise ModelError(f"{where}: pitch {pitch} on a {type} joint (only a helical joint has a finite pitch)")
+        self._joints.append(_Joint(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
 
     # ---------------------------------------------------------------------------------
     def _check_graph(self) -> tuple[str, dict[str, list[_Joint]]]:
@@ -237,11 +242,13 @@ class ModelBuilder:
     def build(self, floating_base: bool = False) -> Model:
         """The :class:`Model`; a floating base adds a free joint ``root_joint`` at the root."""
         root, children = self._check_graph()
+        pitch: list[float] = []
         parent, jtype, axis, XR, Xp, theta = [], [], [], [], [], []
         names, jnames, dofs = [], [], []
         frames: list[tuple[str, int, np.ndarray, np.ndarray]] = []
 
-        def new_body(par, code, ax, R, p, name, jname, lim):
+        def new_body(par, code, ax, R, p, name, jname, lim, h=0.0):
+            pitch.append(h)
             parent.append(par)
             jtype.append(code)
             axis.append(ax)
@@ -275,7 +282,7 @@ class ModelBuilder:
                     f"{jt.parent!r} moves with body {names[b]!r}"
                 )
             else:
-                nb = new_body(b, JOINT_TYPES[jt.type], jt.axis, Rj, pj, jt.child, jt.name, jt.limits)
+                nb = new_body(b, JOINT_TYPES[jt.type], jt.axis, Rj, pj, jt.child, jt.name, jt.limits, jt.pitch)
                 place[jt.child] = (nb, np.eye(3), np.zeros(3))
             order.append(jt.child)
             stack.extend(reversed(children[jt.child]))
@@ -295,7 +302,7 @@ class ModelBuilder:
 
         nb = len(parent)
         return Model(
-            parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)),
+            parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)), joint_pitch=pitch,
             X_tree_R=np.reshape(XR, (nb, 3, 3)), X_tree_p=np.reshape(Xp, (nb, 3)),
             inertia=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
             gravity=self.gravity, lower=col("lower"), upper=col("upper"),

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._jit import inline
 from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, XTREE_P, XTREE_R
-from .joints import PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
+from .joints import HELICAL, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
@@ -28,15 +28,17 @@ def local_placement(jtype, row, q, iq, Rj):
     P, J, R = XTREE_P, JOINT_CONSTANTS, XTREE_R
     if jtype == REVOLUTE:
         s, c = sincos(q[iq])
-        return (True, (_mix(row, J, c, s), _mix(row, J + 1, c, s), _mix(row, J + 2, c, s), _mix(row, J + 3, c, s),
-                       _mix(row, J + 4, c, s), _mix(row, J + 5, c, s), _mix(row, J + 6, c, s),
-                       _mix(row, J + 7, c, s), _mix(row, J + 8, c, s)),
-                (row[P], row[P + 1], row[P + 2]))
+        return True, _revolute_rotation(row, c, s), (row[P], row[P + 1], row[P + 2])
     if jtype == PRISMATIC:
         x = q[iq]
         return (True, (row[R], row[R + 1], row[R + 2], row[R + 3], row[R + 4], row[R + 5], row[R + 6], row[R + 7],
                        row[R + 8]),
                 (row[P] + row[J] * x, row[P + 1] + row[J + 1] * x, row[P + 2] + row[J + 2] * x))
+    if jtype == HELICAL:  # the revolute rotation, and pitch * q along the axis
+        x = q[iq]
+        s, c = sincos(x)
+        return (True, _revolute_rotation(row, c, s),
+                (row[P] + row[J + 27] * x, row[P + 1] + row[J + 28] * x, row[P + 2] + row[J + 29] * x))
     if jtype == SPHERICAL:  # X_tree * rotation of the quaternion
         if not unit_rotation(q, iq, Rj):
             return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
@@ -48,6 +50,15 @@ def local_placement(jtype, row, q, iq, Rj):
     return (True, _tree_rotation(row, Rj),
             (row[9] + row[0] * x + row[1] * y + row[2] * z, row[10] + row[3] * x + row[4] * y + row[5] * z,
              row[11] + row[6] * x + row[7] * y + row[8] * z))
+
+
+@inline
+def _revolute_rotation(row, c, s):
+    """``R_tree Rot(a, q) = C + cos q A + sin q B`` (a 9-tuple) from the joint constants."""
+    J = JOINT_CONSTANTS
+    return (_mix(row, J, c, s), _mix(row, J + 1, c, s), _mix(row, J + 2, c, s), _mix(row, J + 3, c, s),
+            _mix(row, J + 4, c, s), _mix(row, J + 5, c, s), _mix(row, J + 6, c, s), _mix(row, J + 7, c, s),
+            _mix(row, J + 8, c, s))
 
 
 @inline

@@ -13,6 +13,9 @@ revolute    1    1    angle about ``axis`` (continuous joints are revolute joint
 prismatic   1    1    displacement along ``axis``
 free        7    6    ``[x, y, z, qx, qy, qz, qw]``, ``[v_lin, omega]`` in the child frame
 spherical   4    3    ``[qx, qy, qz, qw]`` (a ball joint), ``omega`` in the child frame
+helical     1    1    angle about ``axis`` with a translation ``pitch * angle`` along it
+                      (a screw; ``S = [pitch axis; axis]``, Pinocchio's
+                      ``JointModelHelicalUnaligned``)
 =========== ==== ==== ================================================================
 
 Free and spherical joints hold a unit quaternion (scalar last) at ``QUAT_OFFSET`` in their
@@ -29,18 +32,20 @@ REVOLUTE = 0
 PRISMATIC = 1
 FREE = 2
 SPHERICAL = 3
+HELICAL = 4
 
-NAMES = ("revolute", "prismatic", "free", "spherical")
-NQ = np.array([1, 1, 7, 4], dtype=np.int64)
-NV = np.array([1, 1, 6, 3], dtype=np.int64)
-# Where a joint's unit quaternion starts in its q (-1: none); where its angular velocity starts in v.
-QUAT_OFFSET = np.array([-1, -1, 3, 0], dtype=np.int64)
-OMEGA_OFFSET = np.array([-1, -1, 3, 0], dtype=np.int64)
+NAMES = ("revolute", "prismatic", "free", "spherical", "helical")
+NQ = np.array([1, 1, 7, 4, 1], dtype=np.int64)
+NV = np.array([1, 1, 6, 3, 1], dtype=np.int64)
+# Where a joint's unit quaternion starts in its q (-1: none).
+QUAT_OFFSET = np.array([-1, -1, 3, 0, -1], dtype=np.int64)
+# Joints with an axis (normalised by the model; zero is an error).
+AXIAL = (REVOLUTE, PRISMATIC, HELICAL)
 
 
 # Names of the entries of a joint's q and v (a joint of one entry goes by the joint's name alone).
-Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "qz", "qw"))
-V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"))
+Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "qz", "qw"), ())
+V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"), ())
 
 
 def coordinate_names(joint_types, joint_names, kind: str = "v", sep: str = "[") -> list[str]:
@@ -58,8 +63,10 @@ def coordinate_names(joint_types, joint_names, kind: str = "v", sep: str = "[") 
     return out
 
 
-def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
+def motion_subspace(jtype: int, axis: np.ndarray, pitch: float = 0.0) -> np.ndarray:
     """Columns of ``S`` (nv_joint, 6) in the child frame, spatial order ``[lin; ang]``."""
+    if jtype == HELICAL:
+        return np.concatenate([pitch * axis, axis])[None, :]
     if jtype == REVOLUTE:
         return np.concatenate([np.zeros(3), axis])[None, :]
     if jtype == PRISMATIC:
@@ -75,19 +82,25 @@ def motion_subspace(jtype: int, axis: np.ndarray) -> np.ndarray:
 QUAT_TOL = 1e-3
 
 
-def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray) -> np.ndarray:
-    """Constants (27,) that make ``joint_kernels.body_placement`` cheap for a joint type.
+JOINT_CONSTANTS_SIZE = 30
+
+
+def joint_constants(jtype: int, axis: np.ndarray, R_tree: np.ndarray, pitch: float = 0.0) -> np.ndarray:
+    """Constants (30,) that make ``joint_kernels.body_placement`` cheap for a joint type.
 
     Revolute, with Rodrigues' formula ``Rot(a, q) = a a^T + cos q (1 - a a^T) + sin q [a]x``:
     ``R_tree Rot(a, q) = C + cos q A + sin q B`` with ``C = (R_tree a) a^T``,
-    ``A = R_tree - C`` and ``B = R_tree [a]x`` (row-major, in this order).
+    ``A = R_tree - C`` and ``B = R_tree [a]x`` (row-major, in this order). Helical: the same,
+    then ``pitch R_tree a`` (the translation per radian in the parent frame).
     Prismatic: ``R_tree a`` (the joint's direction in the parent frame) first.
     """
-    out = np.zeros(27)
-    if jtype == REVOLUTE:
+    out = np.zeros(JOINT_CONSTANTS_SIZE)
+    if jtype in (REVOLUTE, HELICAL):
         C = np.outer(R_tree @ axis, axis)
         ax = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
         out[0:9], out[9:18], out[18:27] = C.ravel(), (R_tree - C).ravel(), (R_tree @ ax).ravel()
+        if jtype == HELICAL:
+            out[27:30] = pitch * (R_tree @ axis)
     elif jtype == PRISMATIC:
         out[0:3] = R_tree @ axis
     return out

@@ -50,7 +50,7 @@ INTS_COLUMNS = 7
 # ``body`` columns
 XTREE_R, XTREE_P, JOINT_AXIS, INERTIA, JOINT_CONSTANTS = 0, 9, 12, 15, 25
 INERTIA_END = INERTIA + 10
-BODY_COLUMNS = JOINT_CONSTANTS + 27
+BODY_COLUMNS = JOINT_CONSTANTS + J.JOINT_CONSTANTS_SIZE
 
 # ``dofs`` columns
 MOTION, ARMATURE, DAMPING, COULOMB = 0, 6, 7, 8
@@ -94,11 +94,11 @@ def pack(model) -> KernelTables:
     body[:, INERTIA:INERTIA_END] = model.inertia
     for i in range(nb):
         body[i, JOINT_CONSTANTS:] = J.joint_constants(int(model.joint_type[i]), model.joint_axis[i],
-                                                      model.X_tree_R[i])
+                                                      model.X_tree_R[i], model.joint_pitch[i])
     full = np.zeros((nv, DOF_COLUMNS))
     for i in range(nb):
         k = model.idx_v[i]
-        Si = J.motion_subspace(int(model.joint_type[i]), model.joint_axis[i])
+        Si = J.motion_subspace(int(model.joint_type[i]), model.joint_axis[i], model.joint_pitch[i])
         full[k:k + Si.shape[0], MOTION:MOTION + 6] = Si
     full[:, ARMATURE], full[:, DAMPING], full[:, COULOMB] = model.armature, model.damping, model.coulomb
     for i in range(nb):

@@ -142,8 +142,9 @@ class Model:
     """Immutable rigid-body tree (see the module docstring for the layout).
 
     Per-body arrays (``nb = nbodies``): ``parent`` (nb,), ``joint_type`` (nb,),
-    ``joint_axis`` (nb, 3), ``X_tree_R`` (nb, 3, 3) and ``X_tree_p`` (nb, 3) (joint frame in
-    the parent body frame), ``inertia`` (nb, 10), ``idx_q`` (nb,), ``idx_v`` (nb,).
+    ``joint_axis`` (nb, 3), ``joint_pitch`` (nb,) (metres per radian, helical joints only),
+    ``X_tree_R`` (nb, 3, 3) and ``X_tree_p`` (nb, 3) (joint frame in the parent body frame),
+    ``inertia`` (nb, 10), ``idx_q`` (nb,), ``idx_v`` (nb,).
     Per-dof arrays (nv,): ``lower``, ``upper`` (position limits of 1-dof joints, +-inf for free
     joints), ``velocity_limit``, ``effort_limit``, ``damping`` (viscous, N m s/rad), ``coulomb``
     (N m), ``armature`` (reflected rotor inertia, kg m^2). Frames (nf): ``frame_names``,
@@ -152,7 +153,7 @@ class Model:
     """
 
     __slots__ = (
-        "name", "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia",
+        "name", "parent", "joint_type", "joint_axis", "joint_pitch", "X_tree_R", "X_tree_p", "inertia",
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
         "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
@@ -183,6 +184,7 @@ class Model:
         frame_body=(),
         frame_R=(),
         frame_p=(),
+        joint_pitch=None,
         name: str = "robot",
         physical: str = "error",
     ):
@@ -213,6 +215,12 @@ class Model:
             return a
 
         axis = arr(joint_axis, (nb, 3), "joint_axis")
+        pitch = arr(joint_pitch, (nb,), "joint_pitch")
+        if not np.all(np.isfinite(pitch)):
+            raise ModelError(f"joint_pitch is not finite: {pitch.tolist()}")
+        if np.any((pitch != 0) & (jt != J.HELICAL)):
+            i = int(np.flatnonzero((pitch != 0) & (jt != J.HELICAL))[0])
+            raise ModelError(f"body {i}: joint_pitch {pitch[i]} on a {J.NAMES[jt[i]]} joint (only helical joints have one)")
         R = arr(X_tree_R, (nb, 3, 3), "X_tree_R")
         p = arr(X_tree_p, (nb, 3), "X_tree_p")
         theta = arr(inertia, (nb, 10), "inertia")
@@ -223,7 +231,7 @@ class Model:
         # every body checked at once; the bodies that fail are checked again one by one, in
         # order, for the message
         finite = np.isfinite(axis).all(1) & np.isfinite(R).reshape(nb, 9).all(1) & np.isfinite(p).all(1)
-        one_dof = (jt == J.REVOLUTE) | (jt == J.PRISMATIC)
+        one_dof = np.isin(jt, J.AXIAL)
         norms = np.linalg.norm(np.where(finite[:, None], axis, 0.0), axis=1)
         Rf = np.where(finite[:, None, None], R, np.eye(3))
         rotation = ((np.abs(Rf @ Rf.transpose(0, 2, 1) - np.eye(3)).reshape(nb, 9).max(1, initial=0.0) <= 1e-9)
@@ -294,6 +302,7 @@ class Model:
         setattr_(self, "parent", _readonly(parent, np.int64))
         setattr_(self, "joint_type", _readonly(jt, np.int64))
         setattr_(self, "joint_axis", _readonly(axis))
+        setattr_(self, "joint_pitch", _readonly(pitch))
         setattr_(self, "X_tree_R", _readonly(R))
         setattr_(self, "X_tree_p", _readonly(p))
         setattr_(self, "inertia", _readonly(theta))
@@ -354,7 +363,7 @@ class Model:
             "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "link_names",
             "body_joint_names", "gravity", "lower", "upper", "velocity_limit", "effort_limit",
             "damping", "coulomb", "armature", "coulomb_smoothing", "frame_names", "frame_body",
-            "frame_R", "frame_p", "name", "physical")}
+            "frame_R", "frame_p", "name", "physical", "joint_pitch")}
         unknown = set(changes) - set(kw)
         if unknown:
             raise TypeError(f"unknown model fields: {sorted(unknown)}")

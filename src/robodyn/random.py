@@ -1,7 +1,8 @@
 """Seeded random models and states, for tests, benchmarks and experiments.
 
 ``random_model(nbodies, seed=0, floating_base=False, branching=0.3, joint_types=...)`` builds
-a tree with revolute and prismatic joints (by default; spherical joints on request) on random
+a tree with revolute and prismatic joints (by default; spherical and helical joints, of random
+pitch, on request) on random
 axes and placements, and random physically
 consistent inertias (positive masses, principal moments satisfying the triangle
 inequality). ``random_state(model, rng)`` draws ``(q, v, a)`` with unit quaternions.
@@ -45,7 +46,7 @@ def random_model(nbodies: int, seed: int = 0, floating_base: bool = False, branc
     body (or the world, for a fixed base), so chains and branches both occur.
     """
     rng = np.random.default_rng(seed)
-    parent, jtype, axis, XR, Xp, theta = [], [], [], [], [], []
+    parent, jtype, axis, XR, Xp, theta, pitch = [], [], [], [], [], [], []
     if floating_base:
         parent.append(-1)
         jtype.append(J.FREE)
@@ -53,12 +54,14 @@ def random_model(nbodies: int, seed: int = 0, floating_base: bool = False, branc
         XR.append(np.eye(3))
         Xp.append(np.zeros(3))
         theta.append(random_inertia(rng))
+        pitch.append(0.0)
     first = len(parent)
     for i in range(first, first + nbodies):
         lowest = 0 if floating_base else -1
         par = i - 1 if rng.random() > branching else int(rng.integers(lowest, i))
         parent.append(max(par, lowest) if i > 0 else -1)
         jtype.append(int(rng.choice(joint_types)))
+        pitch.append(float(rng.uniform(-0.3, 0.3)) if jtype[-1] == J.HELICAL else 0.0)
         a = rng.standard_normal(3)
         axis.append(a / np.linalg.norm(a))
         XR.append(random_rotation(rng))
@@ -67,7 +70,7 @@ def random_model(nbodies: int, seed: int = 0, floating_base: bool = False, branc
     nb = len(parent)
     names = [f"body{i}" for i in range(nb)]
     jnames = ["root_joint" if jtype[i] == J.FREE else f"joint{i}" for i in range(nb)]
-    return Model(parent=parent, joint_type=jtype, joint_axis=np.array(axis), X_tree_R=np.array(XR),
+    return Model(parent=parent, joint_type=jtype, joint_axis=np.array(axis), joint_pitch=pitch, X_tree_R=np.array(XR),
                  X_tree_p=np.array(Xp), inertia=np.array(theta), link_names=names,
                  body_joint_names=jnames, gravity=gravity, name=f"random{nbodies}-seed{seed}")
 

@@ -58,7 +58,8 @@ _CONTINUOUS = ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModel
 _PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 # Pinocchio joint type -> robodyn joint type
 _FROM_PIN = {**dict.fromkeys(_REVOLUTE + _CONTINUOUS, J.REVOLUTE), **dict.fromkeys(_PRISMATIC, J.PRISMATIC),
-             "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL}
+             "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL,
+             **dict.fromkeys(("JointModelHX", "JointModelHY", "JointModelHZ", "JointModelHelicalUnaligned"), J.HELICAL)}
 
 # Symmetric per-dof bounds: robodyn field, Pinocchio's name (the upper bound in Pinocchio >= 4),
 # and the suffix of Pinocchio >= 4's separate lower bound ("lower" + suffix).
@@ -99,7 +100,9 @@ def _check_depth_first(model: Model) -> None:
                              "Pinocchio needs (its parent is not body i - 1 or one of its ancestors)")
 
 
-def _pin_joint(pin, jtype: int, axis: np.ndarray):
+def _pin_joint(pin, jtype: int, axis: np.ndarray, pitch: float = 0.0):
+    if jtype == J.HELICAL:
+        return pin.JointModelHelicalUnaligned(np.asarray(axis, dtype=float), float(pitch))
     if jtype == J.FREE:
         return pin.JointModelFreeFlyer()
     if jtype == J.SPHERICAL:
@@ -149,7 +152,7 @@ def to_pinocchio(model: Model):
     for i in range(model.nbodies):
         parent = int(model.parent[i])
         placement = pin.SE3(np.asarray(model.X_tree_R[i]), np.asarray(model.X_tree_p[i]))
-        jid = pm.addJoint(parent + 1, _pin_joint(pin, int(model.joint_type[i]), model.joint_axis[i]),
+        jid = pm.addJoint(parent + 1, _pin_joint(pin, int(model.joint_type[i]), model.joint_axis[i], model.joint_pitch[i]),
                           placement, model.body_joint_names[i])
         pm.appendBodyToJoint(jid, _pin_inertia(pin, model.inertia[i]), pin.SE3.Identity())
         joint_frame = pm.addJointFrame(jid, body_frame[parent])
@@ -178,8 +181,8 @@ def to_pinocchio(model: Model):
 # Pinocchio -> robodyn
 
 
-def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray]:
-    """robodyn's joint type and axis (child frame) of Pinocchio joint ``j``, or ModelError."""
+def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, float]:
+    """robodyn's joint type, axis (child frame) and pitch of Pinocchio joint ``j``, or ModelError."""
     jm, name = pm.joints[j], pm.names[j]
     kind = jm.shortname()
     if kind == "JointModelMimic":
@@ -197,11 +200,15 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray]:
         if pm.parents[j] != 0:
             raise ModelError(f"{source}: joint {name!r} is a JointModelFreeFlyer below joint "
                              f"{pm.names[pm.parents[j]]!r}; robodyn's free joint must attach to the world")
-        return jtype, np.zeros(3)
+        return jtype, np.zeros(3), 0.0
     if jtype == J.SPHERICAL:
-        return jtype, np.zeros(3)
-    S = np.asarray(jm.createData().S, dtype=float).reshape(6)  # constant, [linear; angular]
-    return jtype, (S[3:] if jtype == J.REVOLUTE else S[:3])
+        return jtype, np.zeros(3), 0.0
+    jd = jm.createData()
+    jm.calc(jd, np.zeros(jm.nq))  # a helical joint's data holds S only once computed
+    S = np.asarray(jd.S, dtype=float).reshape(6)  # constant, [linear; angular]
+    if jtype == J.HELICAL:  # S = [pitch axis; axis]
+        return jtype, S[3:], float(S[:3] @ S[3:])
+    return jtype, (S[3:] if jtype == J.REVOLUTE else S[:3]), 0.0
 
 
 def _link_names_and_frames(pin, pm):
@@ -244,7 +251,7 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, as ``load_urdf``.
 
     Raises ``ModelError`` naming the joint for joint types robodyn has no counterpart of
-    (spherical, planar, translation, universal, helical, composite, ...), mimic joints and
+    (planar, translation, universal, composite, spherical ZYX, ...), mimic joints and
     free flyers below the root. ``rotorInertia`` and ``rotorGearRatio`` (not used by
     Pinocchio's dynamics, which use ``armature``) are not converted: a non-zero
     ``rotorInertia`` is reported by a warning.
@@ -257,7 +264,8 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     pm = pin_model
     source = f"from_pinocchio(model {pm.name!r})"
     joints = range(1, pm.njoints)
-    jtype, axis = zip(*(_joint_type_and_axis(pm, j, source) for j in joints)) if pm.njoints > 1 else ((), ())
+    jtype, axis, pitch = (zip(*(_joint_type_and_axis(pm, j, source) for j in joints)) if pm.njoints > 1
+                          else ((), (), ()))
     names, frames = _link_names_and_frames(pin, pm)
     theta = np.reshape([pm.inertias[j].toDynamicParameters() for j in joints], (len(joints), 10))
     for i, t in enumerate(theta):
@@ -284,6 +292,7 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
                       RobodynWarning, stacklevel=2)
     return Model(
         parent=[pm.parents[j] - 1 for j in joints], joint_type=jtype, joint_axis=np.reshape(axis, (-1, 3)),
+        joint_pitch=np.asarray(pitch, dtype=float),
         X_tree_R=np.reshape([pm.jointPlacements[j].rotation for j in joints], (-1, 3, 3)),
         X_tree_p=np.reshape([pm.jointPlacements[j].translation for j in joints], (-1, 3)),
         inertia=theta, link_names=names, body_joint_names=[pm.names[j] for j in joints],

@@ -89,6 +89,8 @@ class _Writer:
     def joint(self, i, axis, anchor, indent) -> None:
         m = self.m
         jt, k, name = int(m.joint_type[i]), int(m.idx_v[i]), m.body_joint_names[i]
+        if jt not in _KIND:
+            raise ValueError(f"write_mjcf: joint {name!r} is {J.NAMES[jt]}, which MJCF cannot express")
         attrs = f"name={quoteattr(name)} type=\"{_KIND[jt]}\""
         if jt != J.FREE:
             attrs += f' pos="{numbers(anchor)}"'

@@ -93,8 +93,9 @@ def write_urdf(model, path=None) -> str:
     joint_names = set(model.body_joint_names)
     for i in range(model.nbodies):
         jt = model.joint_type[i]
-        if jt == J.SPHERICAL:
-            raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} is spherical, which URDF cannot express")
+        if jt in (J.SPHERICAL, J.HELICAL):
+            raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} is {J.NAMES[jt]}, which URDF cannot "
+                             "express")
         if jt == J.FREE and i == 0 and floating:
             continue
         if jt == J.FREE:  # another free body: a floating joint under the fixed world

@@ -189,9 +189,10 @@ def from_model(model) -> SymbolicModel:
     (module docstring). Revolute and prismatic joints on a fixed base only."""
     if isinstance(model, SymbolicModel):
         return model
-    if np.any(model.joint_type == J.SPHERICAL):
-        raise ModelError(f"model {model.name!r} has a spherical joint; robodyn.symbolic derives "
-                         "fixed-base trees of revolute and prismatic joints only")
+    for kind in (J.SPHERICAL, J.HELICAL):
+        if np.any(model.joint_type == kind):
+            raise ModelError(f"model {model.name!r} has a {J.NAMES[kind]} joint; robodyn.symbolic derives "
+                             "fixed-base trees of revolute and prismatic joints only")
     if model.floating_base or np.any(model.joint_type == J.FREE):
         raise ModelError(
             f"model {model.name!r} has a floating base (free joint); robodyn.symbolic derives "

@@ -1,8 +1,9 @@
-"""Spherical (ball) joints: Pinocchio's JointModelSpherical on random trees mixing every joint
-type, Euler's equations of a body about a fixed point, a spherical pendulum's conserved
-quantities in simulation, and the places a spherical joint cannot go.
+"""Spherical (ball) and helical (screw) joints: Pinocchio's JointModelSpherical and
+JointModelHelicalUnaligned on random trees mixing every joint type, Euler's equations of a body
+about a fixed point, a screw's closed form, a spherical pendulum's conserved quantities in
+simulation, and the places these joints cannot go.
 
-The identities of every algorithm run on random trees with spherical joints too (the ``-sph``
+The identities of every algorithm run on random trees with these joints too (the ``-mixed``
 cases of ``helpers.RANDOM_CASES``)."""
 
 from __future__ import annotations
@@ -17,13 +18,13 @@ from robodyn import joints as J
 from robodyn.interop import from_pinocchio, to_pinocchio
 from robodyn.random import random_model, random_state
 
-MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL)
-CASES = [(7, 0, False), (7, 1, False), (7, 4, False), (7, 0, True), (7, 1, True), (7, 2, True)]
+MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL)
+CASES = [(7, seed, False) for seed in (0, 3, 6)] + [(7, seed, True) for seed in (0, 1, 2)]
 
 
 def mixed_model(n, seed, floating_base):
     model = random_model(n, seed=seed, floating_base=floating_base, branching=0.4, joint_types=MIXED)
-    assert np.sum(model.joint_type == J.SPHERICAL) >= 2
+    assert np.sum(model.joint_type == J.SPHERICAL) >= 1 and np.sum(model.joint_type == J.HELICAL) >= 1
     return model
 
 
@@ -31,8 +32,9 @@ def mixed_model(n, seed, floating_base):
 def test_random_trees_agree_with_pinocchio(n, seed, floating_base):
     model = mixed_model(n, seed, floating_base)
     pm = to_pinocchio(model)
-    assert [pm.joints[j].shortname() for j in range(1, pm.njoints)].count("JointModelSpherical") == \
-        int(np.sum(model.joint_type == J.SPHERICAL))
+    kinds = [pm.joints[j].shortname() for j in range(1, pm.njoints)]
+    assert kinds.count("JointModelSpherical") == int(np.sum(model.joint_type == J.SPHERICAL))
+    assert kinds.count("JointModelHelicalUnaligned") == int(np.sum(model.joint_type == J.HELICAL))
     pd = pm.createData()
     q, v, a = random_state(model, rng_for("spherical-pin", seed, floating_base))
     tau = rd.rnea(model, q, v, a, friction=False)
@@ -67,6 +69,7 @@ def test_random_trees_agree_with_pinocchio(n, seed, floating_base):
     assert_rel(J1, pin.dDifference(pm, q, q1, pin.ARG1), 1e-9, "dDifference/dq1")
     back = from_pinocchio(pm)
     np.testing.assert_array_equal(back.joint_type, model.joint_type)
+    np.testing.assert_allclose(back.joint_pitch, model.joint_pitch, rtol=1e-15, atol=0)
 
 
 def test_euler_equations_about_a_fixed_point():
@@ -91,6 +94,29 @@ def test_euler_equations_about_a_fixed_point():
     assert_rel(rd.crba(model, q), Io, 1e-12, "crba")
     assert_rel(rd.aba(model, q, w, expected), wd, 1e-11, "aba")
     assert_rel(rd.kinetic_energy(model, q, w), 0.5 * w @ Io @ w, 1e-12, "kinetic energy")
+
+
+def test_screw_closed_form():
+    """A body on a vertical screw of pitch h, its centre of mass on the axis: kinetic energy
+    ``(Izz + m h^2) qd^2 / 2``, potential ``m g h q``, so ``tau = (Izz + m h^2) qdd + m g h``."""
+    m, h, Izz = 3.0, 0.05, 0.2
+    b = rd.ModelBuilder("screw")
+    b.add_link("nut")
+    b.add_link("bolt", mass=m, com=(0, 0, 0.3), inertia=np.diag([0.1, 0.15, Izz]))
+    b.add_joint("screw", "helical", "nut", "bolt", axis=(0, 0, 2), pitch=h)
+    model = b.build()
+    assert model.joint_names == ("screw",) and model.joint_pitch.tolist() == [h]
+    g = 9.81
+    for q, qd, qdd in ((0.3, 1.5, -2.0), (-4.0, 0.0, 0.7)):
+        assert_rel(rd.rnea(model, [q], [qd], [qdd]), [(Izz + m * h * h) * qdd + m * g * h], 1e-12, "rnea")
+        assert_rel(rd.crba(model, [q]), [[Izz + m * h * h]], 1e-12, "crba")
+        assert_rel(rd.kinetic_energy(model, [q], [qd]), 0.5 * (Izz + m * h * h) * qd * qd, 1e-12, "energy")
+        np.testing.assert_allclose(rd.frame_pose(model, [q], "bolt")[2, 3], h * q, rtol=1e-15, atol=1e-15)
+    with pytest.raises(rd.ModelError, match="pitch 0.1 on a revolute joint"):
+        bad = rd.ModelBuilder("bad")
+        bad.add_link("a")
+        bad.add_link("b", mass=1.0)
+        bad.add_joint("j", "revolute", "a", "b", pitch=0.1)
 
 
 def spherical_pendulum():
@@ -135,9 +161,22 @@ def test_quaternion_errors_name_the_spherical_joint():
         rd.integrate(model, [0, 0, 0, 2.0], np.zeros(3))
 
 
-def test_where_a_spherical_joint_cannot_go():
+def test_where_these_joints_cannot_go():
     model = spherical_pendulum()
     with pytest.raises(ValueError, match="joint 'ball' is spherical, which URDF cannot express"):
         rd.write_urdf(model)
     with pytest.raises(rd.ModelError, match="has a spherical joint; robodyn.symbolic derives"):
         rd.symbolic.from_model(model)
+    screw = rd.ModelBuilder("screw")
+    screw.add_link("nut")
+    screw.add_link("bolt", mass=1.0, inertia=np.eye(3) * 0.01)
+    screw.add_joint("screw", "helical", "nut", "bolt", pitch=0.01)
+    screw = screw.build()
+    with pytest.raises(ValueError, match="joint 'screw' is helical, which URDF cannot express"):
+        rd.write_urdf(screw)
+    with pytest.raises(ValueError, match="joint 'screw' is helical, which MJCF cannot express"):
+        rd.write_mjcf(screw)
+    with pytest.raises(rd.ModelError, match="has a helical joint; robodyn.symbolic derives"):
+        rd.symbolic.from_model(screw)
+    with pytest.raises(rd.ModelError, match=r"body 0: joint_pitch 0.1 on a revolute joint"):
+        rd.models.load("pendulum").replace(joint_pitch=[0.1])
