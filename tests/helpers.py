@@ -29,22 +29,23 @@ from robodyn.random import random_model, random_state
 G = 9.81
 
 # (bodies, seed, floating base, branching, joint types): chains, branches, 1..15 bodies, both
-# base types; revolute and prismatic joints, and spherical and helical joints mixed in (ids "-mixed")
+# base types; revolute and prismatic joints, and spherical, helical and planar joints mixed in
+# (ids "-mixed")
 ONE_DOF = (J.REVOLUTE, J.PRISMATIC)
-MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL)
+MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL, J.PLANAR)
 RANDOM_CASES = [
     (1, 0, False, 0.3, ONE_DOF), (1, 1, True, 0.3, ONE_DOF), (2, 2, False, 0.5, ONE_DOF), (3, 3, True, 0.9, ONE_DOF),
     (5, 4, False, 0.7, ONE_DOF), (7, 5, True, 0.3, ONE_DOF), (10, 6, False, 0.0, ONE_DOF), (12, 7, True, 0.5, ONE_DOF),
-    (15, 8, False, 0.9, ONE_DOF), (15, 9, True, 0.3, ONE_DOF), (6, 11, False, 0.4, MIXED), (8, 16, True, 0.5, MIXED),
+    (15, 8, False, 0.9, ONE_DOF), (15, 9, True, 0.3, ONE_DOF), (6, 13, False, 0.4, MIXED), (8, 12, True, 0.5, MIXED),
 ]
 RANDOM_MODELS = [random_model(n, seed=s, floating_base=fb, branching=b, joint_types=jt)
                  for n, s, fb, b, jt in RANDOM_CASES]
 RANDOM_IDS = [f"n{n}-seed{s}-{'floating' if fb else 'fixed'}-br{b}{'-mixed' if J.SPHERICAL in jt else ''}"
               for n, s, fb, b, jt in RANDOM_CASES]
-# Models whose velocity is the derivative of the configuration (no free or spherical joint,
-# whose angular velocities are quasi-velocities): identities in coordinates hold on them.
-FIXED_BASE_MODELS = [m for m in RANDOM_MODELS if np.all(J.QUAT_OFFSET[m.joint_type] < 0)]
-FIXED_BASE_IDS = [i for m, i in zip(RANDOM_MODELS, RANDOM_IDS) if np.all(J.QUAT_OFFSET[m.joint_type] < 0)]
+# Models whose velocity is the derivative of the configuration (no free, spherical or planar
+# joint, whose velocities are quasi-velocities): identities in coordinates hold on them.
+FIXED_BASE_MODELS = [m for m in RANDOM_MODELS if np.all(J.NQ[m.joint_type] == 1)]
+FIXED_BASE_IDS = [i for m, i in zip(RANDOM_MODELS, RANDOM_IDS) if np.all(J.NQ[m.joint_type] == 1)]
 
 random_models = pytest.mark.parametrize("model", RANDOM_MODELS, ids=RANDOM_IDS)
 fixed_base_models = pytest.mark.parametrize("model", FIXED_BASE_MODELS, ids=FIXED_BASE_IDS)
@@ -109,14 +110,19 @@ def quat_to_matrix(quat) -> np.ndarray:
 
 
 def _rotation_joints(model: rd.Model):
-    """``(q index, v index, free)`` of the free and spherical joints."""
+    """``(q index, v index, free)`` of the free and spherical joints (quaternions)."""
     for i in np.flatnonzero((model.joint_type == J.FREE) | (model.joint_type == J.SPHERICAL)):
         yield int(model.idx_q[i]), int(model.idx_v[i]), bool(model.joint_type[i] == J.FREE)
 
 
 def _scalar_joints(model: rd.Model) -> tuple[np.ndarray, np.ndarray]:
-    one = (model.joint_type != J.FREE) & (model.joint_type != J.SPHERICAL)
+    one = J.NQ[model.joint_type] == 1
     return model.idx_q[one], model.idx_v[one]
+
+
+def _planar_joints(model: rd.Model):
+    for i in np.flatnonzero(model.joint_type == J.PLANAR):
+        yield int(model.idx_q[i]), int(model.idx_v[i])
 
 
 def integrate(model: rd.Model, q, v, dt: float) -> np.ndarray:
@@ -132,6 +138,13 @@ def integrate(model: rd.Model, q, v, dt: float) -> np.ndarray:
         if free:
             out[kq:kq + 3] += quat_to_matrix(q[k:k + 4]) @ v[kv:kv + 3] * dt
         out[k:k + 4] = quat_mul(q[k:k + 4], quat_exp(v[o:o + 3] * dt))
+    for kq, kv in _planar_joints(model):  # constant body velocity (vx, vy, w): an arc in the plane
+        t0, w = np.arctan2(q[kq + 3], q[kq + 2]), v[kv + 2]
+        a, b = (np.sin(w * dt) / w, (1 - np.cos(w * dt)) / w) if w != 0 else (dt, 0.0)
+        lx, ly = a * v[kv] - b * v[kv + 1], b * v[kv] + a * v[kv + 1]  # in the body frame at t = 0
+        out[kq] += np.cos(t0) * lx - np.sin(t0) * ly
+        out[kq + 1] += np.sin(t0) * lx + np.cos(t0) * ly
+        out[kq + 2], out[kq + 3] = np.cos(t0 + w * dt), np.sin(t0 + w * dt)
     return out
 
 
@@ -146,6 +159,10 @@ def configuration_rate(model: rd.Model, q, v) -> np.ndarray:
         if free:
             qd[kq:kq + 3] = quat_to_matrix(q[k:k + 4]) @ v[kv:kv + 3]
         qd[k:k + 4] = 0.5 * quat_mul(q[k:k + 4], np.append(v[o:o + 3], 0.0))
+    for kq, kv in _planar_joints(model):  # (x, y)' = Rz(t) (vx, vy); (c, s)' = w (-s, c)
+        c, s = q[kq + 2], q[kq + 3]
+        qd[kq], qd[kq + 1] = c * v[kv] - s * v[kv + 1], s * v[kv] + c * v[kv + 1]
+        qd[kq + 2], qd[kq + 3] = -s * v[kv + 2], c * v[kv + 2]
     return qd
 
 

@@ -27,7 +27,8 @@ def pin_model_with_same_joints(model: rd.Model) -> pin.Model:
     for i in range(model.nbodies):
         jt = model.joint_type[i]
         joint = {J.FREE: pin.JointModelFreeFlyer, J.REVOLUTE: pin.JointModelRX, J.PRISMATIC: pin.JointModelPX,
-                 J.SPHERICAL: pin.JointModelSpherical, J.HELICAL: lambda: pin.JointModelHelicalUnaligned(np.array([1.0, 0, 0]), 0.2)}[jt]()
+                 J.SPHERICAL: pin.JointModelSpherical, J.HELICAL: lambda: pin.JointModelHelicalUnaligned(np.array([1.0, 0, 0]), 0.2),
+                 J.PLANAR: pin.JointModelPlanar}[jt]()
         pm.addJoint(0, joint, pin.SE3.Identity(), f"joint{i}")
     return pm
 

@@ -229,7 +229,7 @@ def test_aligned_helical_joints_come_in_as_helical_joints():
 
 @pytest.mark.parametrize("joint, kind", [
     (pin.JointModelSphericalZYX(), "JointModelSphericalZYX"),
-    (pin.JointModelPlanar(), "JointModelPlanar"), (pin.JointModelTranslation(), "JointModelTranslation"),
+    (pin.JointModelTranslation(), "JointModelTranslation"),
     (pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])), "JointModelUniversal"),
 ])
 def test_unsupported_joint_types_are_named(joint, kind):

@@ -18,13 +18,14 @@ from robodyn import joints as J
 from robodyn.interop import from_pinocchio, to_pinocchio
 from robodyn.random import random_model, random_state
 
-MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL)
-CASES = [(7, seed, False) for seed in (0, 3, 6)] + [(7, seed, True) for seed in (0, 1, 2)]
+MIXED = (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL, J.PLANAR)
+CASES = [(7, seed, False) for seed in (4, 6, 7)] + [(7, seed, True) for seed in (5, 8, 11)]
 
 
 def mixed_model(n, seed, floating_base):
     model = random_model(n, seed=seed, floating_base=floating_base, branching=0.4, joint_types=MIXED)
-    assert np.sum(model.joint_type == J.SPHERICAL) >= 1 and np.sum(model.joint_type == J.HELICAL) >= 1
+    for kind in (J.SPHERICAL, J.HELICAL, J.PLANAR):
+        assert np.sum(model.joint_type == kind) >= 1, J.NAMES[kind]
     return model
 
 
@@ -35,6 +36,7 @@ def test_random_trees_agree_with_pinocchio(n, seed, floating_base):
     kinds = [pm.joints[j].shortname() for j in range(1, pm.njoints)]
     assert kinds.count("JointModelSpherical") == int(np.sum(model.joint_type == J.SPHERICAL))
     assert kinds.count("JointModelHelicalUnaligned") == int(np.sum(model.joint_type == J.HELICAL))
+    assert kinds.count("JointModelPlanar") == int(np.sum(model.joint_type == J.PLANAR))
     pd = pm.createData()
     q, v, a = random_state(model, rng_for("spherical-pin", seed, floating_base))
     tau = rd.rnea(model, q, v, a, friction=False)
@@ -117,6 +119,32 @@ def test_screw_closed_form():
         bad.add_link("a")
         bad.add_link("b", mass=1.0)
         bad.add_joint("j", "revolute", "a", "b", pitch=0.1)
+
+
+def test_planar_body_closed_form():
+    """A body moving in a horizontal plane (gravity along the normal does no work): with its
+    centre of mass at c in the body frame, ``M = [[m, 0, -m cy], [0, m, m cx], [-m cy, m cx,
+    Izz + m |c|^2]]`` on ``[vx, vy, wz]``, and the bias of a turning body is the centripetal
+    force ``-m w^2 c`` (body frame) plus the Coriolis term of the sliding velocity."""
+    m, c, Izz = 2.0, np.array([0.3, -0.1, 0.05]), 0.2
+    b = rd.ModelBuilder("puck")
+    b.add_link("table")
+    b.add_link("puck", mass=m, com=c, inertia=np.diag([0.1, 0.1, Izz]))
+    b.add_joint("slide", "planar", "table", "puck", xyz=(0, 0, 1))
+    model = b.build()
+    assert (model.nq, model.nv) == (4, 3) and model.joint_names == ()
+    t = 0.8
+    q = np.array([0.5, -0.4, np.cos(t), np.sin(t)])
+    M = np.array([[m, 0, -m * c[1]], [0, m, m * c[0]], [-m * c[1], m * c[0], Izz + m * (c[0] ** 2 + c[1] ** 2)]])
+    assert_rel(rd.crba(model, q), M, 1e-12, "crba")
+    vx, vy, w = 0.7, -0.3, 1.5
+    # d/dt of the body-frame momentum: (p_lin)' + w x p_lin, with p_lin = m (v + w x c)
+    vel_c = np.array([vx - w * c[1], vy + w * c[0], 0.0])  # velocity of the centre of mass, body axes
+    force = m * np.cross([0, 0, w], vel_c)
+    torque = np.cross(c, force)[2]
+    assert_rel(rd.nonlinear_effects(model, q, [vx, vy, w]), [force[0], force[1], torque], 1e-12, "bias")
+    with pytest.raises(ValueError, match=r"rnea: q: \(cos, sin\) of planar joint 'slide' \(q\[2:4\]\) has norm 2"):
+        rd.rnea(model, [0, 0, 2.0, 0], np.zeros(3), np.zeros(3))
 
 
 def spherical_pendulum():

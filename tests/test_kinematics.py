@@ -32,6 +32,9 @@ def poses_by_hand(model, q):
             p = axis * q[iq]
         elif model.joint_type[i] == J.HELICAL:
             R, p = _rodrigues(axis, q[iq]), model.joint_pitch[i] * q[iq] * axis
+        elif model.joint_type[i] == J.PLANAR:
+            t = np.arctan2(q[iq + 3], q[iq + 2])
+            R, p = _rodrigues(np.array([0.0, 0.0, 1.0]), t), np.array([q[iq], q[iq + 1], 0.0])
         elif model.joint_type[i] == J.SPHERICAL:
             R = quat_to_matrix(q[iq:iq + 4])
         else:

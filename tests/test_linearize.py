@@ -43,18 +43,18 @@ def by_differences(model, q, v, tau, integrator):
     return J[:, :2 * n], J[:, 2 * n:]
 
 
-ONE_DOF, MIXED = (J.REVOLUTE, J.PRISMATIC), (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL)
+ONE_DOF, MIXED = (J.REVOLUTE, J.PRISMATIC), (J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL, J.PLANAR)
 CASES = [(4, 1, False, "semi_implicit_euler", ONE_DOF), (4, 1, False, "rk4", ONE_DOF),
          (5, 2, True, "semi_implicit_euler", ONE_DOF), (5, 2, True, "rk4", ONE_DOF),
          (3, 3, True, "semi_implicit_euler", ONE_DOF), (3, 3, True, "rk4", ONE_DOF),
-         (4, 12, False, "semi_implicit_euler", MIXED), (4, 12, False, "rk4", MIXED), (4, 13, True, "rk4", MIXED)]
+         (4, 13, False, "semi_implicit_euler", MIXED), (4, 13, False, "rk4", MIXED), (4, 24, True, "rk4", MIXED)]
 
 
 @pytest.mark.parametrize("n, seed, floating_base, integrator, joint_types", CASES)
 def test_against_differences_of_simulate(n, seed, floating_base, integrator, joint_types):
     rng = rng_for("linearize", n, seed, floating_base, integrator)
     base = random_model(n, seed=seed, floating_base=floating_base, branching=0.5, joint_types=joint_types)
-    assert (J.SPHERICAL in base.joint_type) == (joint_types == MIXED)
+    assert all(kind in base.joint_type for kind in (J.SPHERICAL, J.PLANAR)) == (joint_types == MIXED)
     model = base.replace(damping=rng.uniform(0.1, 1.0, base.nv), armature=rng.uniform(0.01, 0.1, base.nv),
                          coulomb=rng.uniform(0.1, 1.0, base.nv), coulomb_smoothing=0.5)
     q, v, tau = random_state(model, rng)

@@ -641,6 +641,20 @@ def test_floating_joint_is_a_free_joint_under_the_world():
         rd.load_urdf(_robot(_ARM, _link("box", 1.0), _joint("float", "floating", "arm", "box")))
 
 
-def test_planar_joint_is_refused_with_its_name():
-    with pytest.raises(rd.ModelError, match=r"<joint name='p'> \(line \d+\): joint type 'planar' is not supported"):
-        rd.load_urdf(_robot(_ARM, _link("box", 1.0), _joint("p", "planar", "arm", "box")))
+def test_planar_joint_matches_pinocchio_and_needs_a_z_normal():
+    """A URDF planar joint (the plane's normal as its axis, z) is robodyn's planar joint, as it
+    is Pinocchio's JointModelPlanar: q = [x, y, cos t, sin t]."""
+    text = _robot(_link("world"), _link("base", 2.0, xyz="0.1 0 0.2"), _link("arm", 1.0, xyz="0 0 0.2"),
+                  _joint("plane", "planar", "world", "base", xyz="0 0 0.5", rpy="0.1 0.2 0.3", axis="0 0 1"),
+                  _joint("j", "revolute", "base", "arm", axis="0 1 0",
+                         extra='<limit lower="-1" upper="1" effort="5" velocity="2"/>'))
+    model = rd.load_urdf(text)
+    assert (model.nq, model.nv) == (5, 4) and model.joint_type.tolist() == [joints.PLANAR, joints.REVOLUTE]
+    pm = pin.buildModelFromXML(text)
+    assert pm.joints[1].shortname() == "JointModelPlanar"
+    q = np.array([0.3, -0.2, np.cos(0.7), np.sin(0.7), 0.4])
+    v, a = np.array([0.1, 0.2, 0.3, 0.4]), np.array([0.5, -0.1, 0.2, 0.3])
+    np.testing.assert_allclose(rd.rnea(model, q, v, a), pin.rnea(pm, pm.createData(), q, v, a), rtol=1e-12, atol=1e-12)
+    with pytest.raises(rd.ModelError, match=r"<joint name='p'> \(line \d+\): planar joint with axis \[1.0, 0.0, 0.0\]: "
+                                            r"only the joint frame's z axis"):
+        rd.load_urdf(_robot(_ARM, _link("box", 1.0), _joint("p", "planar", "arm", "box", axis="1 0 0")))

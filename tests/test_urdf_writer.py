@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
+from robodyn import joints as J
 from helpers import assert_rel, random_model, rng_for, states
 
 
@@ -20,8 +21,7 @@ def _permutations(model, other):
     pq, pv = [], []
     for j in range(other.nbodies):
         i = model.body_joint_names.index(other.body_joint_names[j])
-        nq = (7 if model.joint_type[i] == 2 else 1)
-        nv = (6 if model.joint_type[i] == 2 else 1)
+        nq, nv = J.NQ[model.joint_type[i]], J.NV[model.joint_type[i]]
         pq += list(range(model.idx_q[i], model.idx_q[i] + nq))
         pv += list(range(model.idx_v[i], model.idx_v[i] + nv))
     return np.array(pq), np.array(pv)
@@ -113,3 +113,12 @@ def test_free_bodies_beside_a_fixed_base_round_trip_as_floating_joints():
     assert two.floating_base and two.nv == 12
     with pytest.raises(ValueError, match="free joint 'fb' beside a floating base"):
         rd.write_urdf(two)
+
+
+def test_planar_joints_round_trip():
+    model = random_model(5, seed=3, branching=0.5, joint_types=(J.REVOLUTE, J.PLANAR))
+    assert J.PLANAR in model.joint_type
+    back = rd.load_urdf(rd.write_urdf(model))
+    q, v, a = states(model, "planar", size=2)
+    pq, pv = _permutations(model, back)
+    assert_rel(rd.rnea(back, q[:, pq], v[:, pv], a[:, pv]), rd.rnea(model, q, v, a)[:, pv], 1e-12)

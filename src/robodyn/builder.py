@@ -35,7 +35,7 @@ from .model import (Model, ModelError, check_inertial_parameters, consistent_ine
                     inertial_parameters_from, inertial_parameters_in_parent)
 
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
-               "spherical": J.SPHERICAL, "helical": J.HELICAL, "fixed": None}
+               "spherical": J.SPHERICAL, "helical": J.HELICAL, "planar": J.PLANAR, "fixed": None}
 
 
 def rpy_to_matrix(rpy) -> np.ndarray:
@@ -152,7 +152,8 @@ class ModelBuilder:
 
         ``type`` is ``revolute``, ``continuous``, ``prismatic``, ``helical`` (a screw: rotation
         about ``axis`` with a translation ``pitch`` metres per radian along it), ``fixed``,
-        ``spherical`` (a ball
+        ``planar`` (``q = [x, y, cos t, sin t]``: the child moves in the joint frame's x-y
+        plane and turns about its z axis), ``spherical`` (a ball
         joint: ``q = [qx, qy, qz, qw]`` rotates the child in the joint frame) or ``free`` (a
         6-dof joint, whose parent link must be the root or welded to it: its configuration
         ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame)."""
@@ -166,14 +167,14 @@ class ModelBuilder:
             if not np.all(np.isfinite(a)):
                 raise ModelError(f"{where}: {what} is not finite")
         R = rpy_to_matrix(rot) if rotation is None else rot
-        if type in ("free", "spherical"):
+        if type in ("free", "spherical", "planar"):
             ax = np.zeros(3)
         elif type != "fixed":
             n = np.linalg.norm(ax)
             if n < 1e-12:
                 raise ModelError(f"{where}: joint axis is zero")
             ax = ax / n
-        if type in ("continuous", "free", "spherical"):
+        if type in ("continuous", "free", "spherical", "planar"):
             lower, upper = -np.inf, np.inf
         limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
                       effort=float(effort), damping=float(damping), friction=float(friction),

@@ -8,7 +8,7 @@ import numpy as np
 
 from ._jit import inline
 from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, XTREE_P, XTREE_R
-from .joints import HELICAL, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
+from .joints import HELICAL, PLANAR, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
@@ -23,8 +23,9 @@ def _mix(row, j, c, s):
 def local_placement(jtype, row, q, iq, Rj):
     """``(ok, R, p)``: the placement of a body in its parent, ``X_tree * X_J(q)``, from the
     body's kernel row (``layout.pack``), as values: ``R`` a 9-tuple (row by row), ``p`` a
-    3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a joint's quaternion is
-    farther than ``QUAT_TOL`` from unit norm (a near-unit quaternion is normalised)."""
+    3-tuple; ``Rj`` is a 3 x 3 workspace. ``ok`` is False when a joint's quaternion (or a
+    planar joint's (cos, sin)) is farther than ``QUAT_TOL`` from unit norm (a near-unit one is
+    normalised)."""
     P, J, R = XTREE_P, JOINT_CONSTANTS, XTREE_R
     if jtype == REVOLUTE:
         s, c = sincos(q[iq])
@@ -39,6 +40,17 @@ def local_placement(jtype, row, q, iq, Rj):
         s, c = sincos(x)
         return (True, _revolute_rotation(row, c, s),
                 (row[P] + row[J + 27] * x, row[P + 1] + row[J + 28] * x, row[P + 2] + row[J + 29] * x))
+    if jtype == PLANAR:  # X_tree * (Rz(t), (x, y, 0)) with (cos t, sin t) normalised
+        c, s = q[iq + 2], q[iq + 3]
+        n = np.sqrt(c * c + s * s)
+        if not abs(n - 1.0) <= QUAT_TOL:
+            return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)
+        c, s, x, y = c / n, s / n, q[iq], q[iq + 1]
+        return (True, (row[R] * c + row[R + 1] * s, row[R + 1] * c - row[R] * s, row[R + 2],
+                       row[R + 3] * c + row[R + 4] * s, row[R + 4] * c - row[R + 3] * s, row[R + 5],
+                       row[R + 6] * c + row[R + 7] * s, row[R + 7] * c - row[R + 6] * s, row[R + 8]),
+                (row[P] + row[R] * x + row[R + 1] * y, row[P + 1] + row[R + 3] * x + row[R + 4] * y,
+                 row[P + 2] + row[R + 6] * x + row[R + 7] * y))
     if jtype == SPHERICAL:  # X_tree * rotation of the quaternion
         if not unit_rotation(q, iq, Rj):
             return False, (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0)

@@ -16,6 +16,9 @@ spherical   4    3    ``[qx, qy, qz, qw]`` (a ball joint), ``omega`` in the chil
 helical     1    1    angle about ``axis`` with a translation ``pitch * angle`` along it
                       (a screw; ``S = [pitch axis; axis]``, Pinocchio's
                       ``JointModelHelicalUnaligned``)
+planar      4    3    ``[x, y, cos t, sin t]``: a translation in the joint frame's x-y plane
+                      and a rotation ``t`` about its z axis; ``[vx, vy, wz]`` in the child
+                      frame (Pinocchio's ``JointModelPlanar``)
 =========== ==== ==== ================================================================
 
 Free and spherical joints hold a unit quaternion (scalar last) at ``QUAT_OFFSET`` in their
@@ -33,19 +36,24 @@ PRISMATIC = 1
 FREE = 2
 SPHERICAL = 3
 HELICAL = 4
+PLANAR = 5
 
-NAMES = ("revolute", "prismatic", "free", "spherical", "helical")
-NQ = np.array([1, 1, 7, 4, 1], dtype=np.int64)
-NV = np.array([1, 1, 6, 3, 1], dtype=np.int64)
+NAMES = ("revolute", "prismatic", "free", "spherical", "helical", "planar")
+NQ = np.array([1, 1, 7, 4, 1, 4], dtype=np.int64)
+NV = np.array([1, 1, 6, 3, 1, 3], dtype=np.int64)
 # Where a joint's unit quaternion starts in its q (-1: none).
-QUAT_OFFSET = np.array([-1, -1, 3, 0, -1], dtype=np.int64)
+QUAT_OFFSET = np.array([-1, -1, 3, 0, -1, -1], dtype=np.int64)
+# Where the unit vector of a joint's rotation (a quaternion, or a planar joint's (cos, sin))
+# starts in its q, and its length (0: none). Joints with nq == 1 are scalar: q + v moves them.
+UNIT_OFFSET = np.array([-1, -1, 3, 0, -1, 2], dtype=np.int64)
+UNIT_SIZE = np.array([0, 0, 4, 4, 0, 2], dtype=np.int64)
 # Joints with an axis (normalised by the model; zero is an error).
 AXIAL = (REVOLUTE, PRISMATIC, HELICAL)
 
 
 # Names of the entries of a joint's q and v (a joint of one entry goes by the joint's name alone).
-Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "qz", "qw"), ())
-V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"), ())
+Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "qz", "qw"), (), ("x", "y", "c", "s"))
+V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"), (), ("vx", "vy", "wz"))
 
 
 def coordinate_names(joint_types, joint_names, kind: str = "v", sep: str = "[") -> list[str]:
@@ -75,10 +83,13 @@ def motion_subspace(jtype: int, axis: np.ndarray, pitch: float = 0.0) -> np.ndar
         return np.eye(6)
     if jtype == SPHERICAL:
         return np.eye(6)[3:]
+    if jtype == PLANAR:
+        return np.eye(6)[[0, 1, 5]]
     raise ValueError(f"unknown joint type code {jtype}")
 
 
-# A free or spherical joint's quaternion may be this far from unit norm; it is normalised, farther is an error.
+# A quaternion (or a planar joint's (cos, sin)) may be this far from unit norm; it is normalised,
+# farther is an error.
 QUAT_TOL = 1e-3
 
 

@@ -258,9 +258,9 @@ class Model:
         if not np.all(np.isfinite(g)):
             raise ModelError("gravity is not finite")
 
-        free_dof = np.zeros(nv, dtype=bool)  # no position limits on free and spherical joints
+        free_dof = np.zeros(nv, dtype=bool)  # no position limits on free, spherical, planar joints
         for i in range(nb):
-            if J.QUAT_OFFSET[jt[i]] >= 0:
+            if J.NQ[jt[i]] > 1:
                 free_dof[idx_v[i]:idx_v[i] + nv_i[i]] = True
         lo = arr(lower, (nv,), "lower", -np.inf)
         hi = arr(upper, (nv,), "upper", np.inf)
@@ -402,7 +402,7 @@ class Model:
         ]
         for i in range(self.nbodies):
             par = self.link_names[self.parent[i]] if self.parent[i] >= 0 else "world"
-            ax = "" if self.joint_type[i] in (J.FREE, J.SPHERICAL) else np.array2string(self.joint_axis[i], precision=3, suppress_small=True)
+            ax = "" if J.NQ[self.joint_type[i]] > 1 else np.array2string(self.joint_axis[i], precision=3, suppress_small=True)
             lines.append(
                 f"  {i:>3} {self.link_names[i]:<24} {self.body_joint_names[i]:<24} "
                 f"{J.NAMES[self.joint_type[i]]:<9} {par:<20} {ax:<22} {self.inertia[i, 0]:>9.4g}"

@@ -1,8 +1,8 @@
 """Seeded random models and states, for tests, benchmarks and experiments.
 
 ``random_model(nbodies, seed=0, floating_base=False, branching=0.3, joint_types=...)`` builds
-a tree with revolute and prismatic joints (by default; spherical and helical joints, of random
-pitch, on request) on random
+a tree with revolute and prismatic joints (by default; spherical, helical (of random pitch)
+and planar joints on request) on random
 axes and placements, and random physically
 consistent inertias (positive masses, principal moments satisfying the triangle
 inequality). ``random_state(model, rng)`` draws ``(q, v, a)`` with unit quaternions.
@@ -79,13 +79,14 @@ def random_configuration(model: Model, rng: np.random.Generator, size=()) -> np.
     """Random ``q`` (size + (nq,)): joints in [-pi, pi], positions in [-1, 1], unit quaternions."""
     size = (size,) if isinstance(size, int) else tuple(size)
     q = rng.uniform(-np.pi, np.pi, size + (model.nq,))
-    for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
-        k = model.idx_q[i]
-        if model.joint_type[i] == J.FREE:
-            q[..., k:k + 3] = rng.uniform(-1, 1, size + (3,))
-        quat = rng.standard_normal(size + (4,))
-        k += J.QUAT_OFFSET[model.joint_type[i]]
-        q[..., k:k + 4] = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
+    for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
+        k, jt = model.idx_q[i], model.joint_type[i]
+        if jt in (J.FREE, J.PLANAR):
+            n = 3 if jt == J.FREE else 2
+            q[..., k:k + n] = rng.uniform(-1, 1, size + (n,))
+        unit = rng.standard_normal(size + (J.UNIT_SIZE[jt],))
+        k += J.UNIT_OFFSET[jt]
+        q[..., k:k + J.UNIT_SIZE[jt]] = unit / np.linalg.norm(unit, axis=-1, keepdims=True)
     return q
 
 

@@ -3,7 +3,8 @@
 Configurations of 1-dof joints add: ``q_i + v_i``. A free joint's configuration is a pose
 ``(p, R)`` (``q = [p, quaternion (x, y, z, w)]``) and its velocity a twist ``[v_lin, omega]``
 in the child (base) frame; it moves by the exponential map of SE(3), as Pinocchio does (a
-spherical joint, ``q = quaternion``, ``v = omega``, by its rotation part, that of SO(3))::
+spherical joint, ``q = quaternion``, ``v = omega``, by its rotation part, that of SO(3); a
+planar joint, ``q = [x, y, cos t, sin t]``, ``v = [vx, vy, wz]``, by that of SE(2))::
 
     integrate:   (p, R) ⊕ xi = (p, R) exp(xi),      exp(xi) = (V(omega) v_lin, exp3(omega))
     difference:  q1 ⊖ q0 = log((p0, R0)^-1 (p1, R1))
@@ -26,31 +27,54 @@ from . import _inputs
 from .status import require_finite_result
 
 
+# The components of an SE(3) twist ``[v_lin, omega]`` a joint of several dofs moves along: a
+# spherical joint is a free joint without translation, a planar joint one restricted to the
+# x-y plane and rotations about z (the subgroups' exponentials, logarithms and Jacobians are
+# those of SE(3) restricted to them).
+TWIST_COMPONENTS = {J.FREE: [0, 1, 2, 3, 4, 5], J.SPHERICAL: [3, 4, 5], J.PLANAR: [0, 1, 5]}
+
+
 def _free_blocks(model):
-    """``(q index, v index, translation)`` of each free (True) and spherical (False) joint. A
-    spherical joint is handled as a free joint without translation: its blocks are the
-    rotation parts of the free joint's (see :func:`_pose` and :func:`_tangent`)."""
-    for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
-        yield int(model.idx_q[i]), int(model.idx_v[i]), bool(model.joint_type[i] == J.FREE)
+    """``(q index, v index, joint type)`` of each free, spherical and planar joint."""
+    for i in np.flatnonzero(J.NQ[model.joint_type] > 1):
+        yield int(model.idx_q[i]), int(model.idx_v[i]), int(model.joint_type[i])
 
 
-def _pose(q, kq, free):
-    """``(position (..., 3), quaternion (..., 4))`` of the joint at ``kq`` (zero position for a
-    spherical joint)."""
-    if free:
+def joint_pose(q, kq, kind):
+    """``(position (..., 3), quaternion (..., 4))`` of the joint at ``kq``."""
+    if kind == J.FREE:
         return q[..., kq:kq + 3], q[..., kq + 3:kq + 7]
-    return np.zeros(q.shape[:-1] + (3,)), q[..., kq:kq + 4]
+    zero = np.zeros(q.shape[:-1] + (3,))
+    if kind == J.SPHERICAL:
+        return zero, q[..., kq:kq + 4]
+    half = 0.5 * np.arctan2(q[..., kq + 3], q[..., kq + 2])  # planar: (x, y, 0), a rotation about z
+    p = zero.copy()
+    p[..., :2] = q[..., kq:kq + 2]
+    quat = np.stack([np.zeros_like(half), np.zeros_like(half), np.sin(half), np.cos(half)], -1)
+    return p, quat
 
 
-def _tangent(v, kv, free):
-    """The joint's velocity as a twist (..., 6) ``[v_lin, omega]`` (zero ``v_lin`` if spherical)."""
-    if free:
-        return v[..., kv:kv + 6]
-    return np.concatenate([np.zeros(v.shape[:-1] + (3,)), v[..., kv:kv + 3]], -1)
+def set_joint_pose(out, kq, kind, p, quat) -> None:
+    """Write a joint's pose into its ``q`` (a planar joint keeps x, y and the angle about z)."""
+    if kind == J.FREE:
+        out[..., kq:kq + 3], out[..., kq + 3:kq + 7] = p, quat
+    elif kind == J.SPHERICAL:
+        out[..., kq:kq + 4] = quat
+    else:
+        angle = 2.0 * np.arctan2(quat[..., 2], quat[..., 3])
+        out[..., kq:kq + 2], out[..., kq + 2], out[..., kq + 3] = p[..., :2], np.cos(angle), np.sin(angle)
+
+
+def joint_twist(v, kv, kind):
+    """The joint's velocity as an SE(3) twist (..., 6) ``[v_lin, omega]``."""
+    sel = TWIST_COMPONENTS[kind]
+    xi = np.zeros(v.shape[:-1] + (6,))
+    xi[..., sel] = v[..., kv:kv + len(sel)]
+    return xi
 
 
 def _scalar_indices(model):
-    one = J.QUAT_OFFSET[model.joint_type] < 0
+    one = J.NQ[model.joint_type] == 1
     return model.idx_q[one], model.idx_v[one]
 
 
@@ -75,18 +99,14 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     out = q.copy()
     iq, iv = _scalar_indices(model)
     out[..., iq] += v[..., iv]
-    for kq, kv, free in _free_blocks(model):
-        p0, quat0 = _pose(q, kq, free)
+    for kq, kv, kind in _free_blocks(model):
+        p0, quat0 = joint_pose(q, kq, kind)
         quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
-        dquat, dp = exp_se3(_tangent(v, kv, free))
+        dquat, dp = exp_se3(joint_twist(v, kv, kind))
         quat = quat_mul(quat0, dquat)
         quat *= np.where(np.sum(quat * quat0, -1, keepdims=True) < 0, -1.0, 1.0)  # the sign nearer q's
         quat = quat / np.linalg.norm(quat, axis=-1, keepdims=True)
-        if free:
-            out[..., kq:kq + 3] = p0 + np.einsum("...ij,...j->...i", quat_matrix(quat0), dp)
-            out[..., kq + 3:kq + 7] = quat
-        else:
-            out[..., kq:kq + 4] = quat
+        set_joint_pose(out, kq, kind, p0 + np.einsum("...ij,...j->...i", quat_matrix(quat0), dp), quat)
     require_finite_result("integrate", out, check_finite, {"q": q, "v": v})
     return _inputs.unflatten(out, batch)
 
@@ -113,13 +133,13 @@ def _difference(model, q0, q1, check_finite: bool, what: str) -> np.ndarray:
     d = np.zeros(lead + (model.nv,))
     iq, iv = _scalar_indices(model)
     d[..., iv] = q1[..., iq] - q0[..., iq]
-    for kq, kv, free in _free_blocks(model):
-        (p0, quat0), (p1, quat1) = _pose(q0, kq, free), _pose(q1, kq, free)
+    for kq, kv, kind in _free_blocks(model):
+        (p0, quat0), (p1, quat1) = joint_pose(q0, kq, kind), joint_pose(q1, kq, kind)
         quat0 = quat0 / np.linalg.norm(quat0, axis=-1, keepdims=True)
         conj0 = quat0 * np.array([-1.0, -1.0, -1.0, 1.0])
         dp = np.einsum("...ji,...j->...i", quat_matrix(quat0), p1 - p0)
-        xi = log_se3(quat_mul(conj0, quat1), dp)
-        d[..., kv:kv + 6 if free else kv + 3] = xi if free else xi[..., 3:]
+        sel = TWIST_COMPONENTS[kind]
+        d[..., kv:kv + len(sel)] = log_se3(quat_mul(conj0, quat1), dp)[..., sel]
     return require_finite_result(what, d, check_finite, {"q0": q0, "q1": q1})
 
 
@@ -137,12 +157,12 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     check_configurations(model, check_finite, "integrate_jacobians", q=q, v=v)
     Jq = np.broadcast_to(np.eye(model.nv), q.shape[:-1] + (model.nv, model.nv)).copy()
     Jv = Jq.copy()
-    for _, kv, free in _free_blocks(model):
-        xi = _tangent(v, kv, free)
+    for _, kv, kind in _free_blocks(model):
+        xi = joint_twist(v, kv, kind)
         quat, p = exp_se3(xi)
-        n, o = (6, 0) if free else (3, 3)  # a spherical joint: the rotation blocks
-        Jq[..., kv:kv + n, kv:kv + n] = inverse_adjoint(quat, p)[..., o:, o:]
-        Jv[..., kv:kv + n, kv:kv + n] = right_jacobian_se3(xi)[..., o:, o:]
+        sel, block = TWIST_COMPONENTS[kind], slice(kv, kv + len(TWIST_COMPONENTS[kind]))
+        Jq[..., block, block] = inverse_adjoint(quat, p)[..., sel, :][..., sel]
+        Jv[..., block, block] = right_jacobian_se3(xi)[..., sel, :][..., sel]
     return _inputs.unflatten(Jq, batch), _inputs.unflatten(Jv, batch)
 
 
@@ -157,11 +177,11 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
     d = _difference(model, q0, q1, check_finite, "difference_jacobians")
     J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
     J0 = -J1
-    for _, kv, free in _free_blocks(model):
-        xi = _tangent(d, kv, free)
-        n, o = (6, 0) if free else (3, 3)
-        J1[..., kv:kv + n, kv:kv + n] = np.linalg.inv(right_jacobian_se3(xi)[..., o:, o:])
-        J0[..., kv:kv + n, kv:kv + n] = -np.linalg.inv(right_jacobian_se3(-xi)[..., o:, o:])
+    for _, kv, kind in _free_blocks(model):
+        xi = joint_twist(d, kv, kind)
+        sel, block = TWIST_COMPONENTS[kind], slice(kv, kv + len(TWIST_COMPONENTS[kind]))
+        J1[..., block, block] = np.linalg.inv(right_jacobian_se3(xi)[..., sel, :][..., sel])
+        J0[..., block, block] = -np.linalg.inv(right_jacobian_se3(-xi)[..., sel, :][..., sel])
     return J0, J1
 
 
@@ -186,9 +206,10 @@ def check_configurations(model, check_finite: bool, what: str, **arrays) -> None
     for name, a in arrays.items():
         if a.shape[-1] != model.nq:
             continue
-        for kq, _, free in _free_blocks(model):
-            k = kq + 3 if free else kq
-            n = np.linalg.norm(a[..., k:k + 4], axis=-1)
+        for kq, _, kind in _free_blocks(model):
+            k, size = kq + J.UNIT_OFFSET[kind], J.UNIT_SIZE[kind]
+            n = np.linalg.norm(a[..., k:k + size], axis=-1)
+            unit = "quaternion" if size == 4 else "(cos, sin)"
             if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
-                raise ValueError(f"{what}: {name}: quaternion {name}[{k}:{k + 4}] has norm "
+                raise ValueError(f"{what}: {name}: {unit} {name}[{k}:{k + size}] has norm "
                                  f"{float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))]):.6g}, not 1; normalise it")

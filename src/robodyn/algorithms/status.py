@@ -111,14 +111,15 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
         raise_nonfinite_result(what, arrays)
     if code == BAD_QUATERNION:
         q = arrays["q"]
-        for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
-            k = model.idx_q[i] + J.QUAT_OFFSET[model.joint_type[i]]
-            n = np.linalg.norm(q[..., k:k + 4], axis=-1)
+        for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
+            k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
+            n = np.linalg.norm(q[..., k:k + size], axis=-1)
             if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
                 worst = float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))])
                 kind = J.NAMES[model.joint_type[i]]
+                unit = "quaternion" if size == 4 else "(cos, sin)"
                 raise ValueError(
-                    f"{what}: q: quaternion of {kind} joint {model.body_joint_names[i]!r} (q[{k}:{k + 4}]) has norm "
+                    f"{what}: q: {unit} of {kind} joint {model.body_joint_names[i]!r} (q[{k}:{k + size}]) has norm "
                     f"{worst:.6g}, not 1 (tolerance {J.QUAT_TOL}); normalise it"
                 )
         raise AssertionError("kernel reported a bad quaternion that is not there")

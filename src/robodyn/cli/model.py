@@ -42,13 +42,13 @@ def cmd_info(args) -> int:
 
 def sample_state(model, seed: int = 0):
     """A reproducible sample state: mid-range joint angles, moderate speeds and accelerations."""
-    from ..joints import QUAT_OFFSET
+    from ..joints import NQ
     from ..random import random_configuration
 
     rng = np.random.default_rng(seed)
     q = random_configuration(model, rng)
     for i in range(model.nbodies):  # joint angles in [-pi/2, pi/2]; free and spherical joints as drawn
-        if QUAT_OFFSET[model.joint_type[i]] < 0:
+        if NQ[model.joint_type[i]] == 1:
             q[model.idx_q[i]] *= 0.5
     v = rng.uniform(-1.0, 1.0, model.nv)
     a = rng.uniform(-2.0, 2.0, model.nv)

@@ -40,7 +40,7 @@ def _vector(text: str | None, n: int, name: str):
 def start_and_target(model, q0=None, target=None):
     """Default start (0, or mid-range outside the limits) and target (``q0 + 0.5`` inside the
     limits) of the 1-dof joints; a floating base starts at the origin, upright."""
-    from ..joints import FREE, SPHERICAL
+    from ..joints import FREE, PLANAR, SPHERICAL
 
     if q0 is None:
         q0 = np.zeros(model.nq)
@@ -50,6 +50,8 @@ def start_and_target(model, q0=None, target=None):
                 q0[k + 6] = 1.0
             elif model.joint_type[i] == SPHERICAL:
                 q0[k + 3] = 1.0
+            elif model.joint_type[i] == PLANAR:
+                q0[k + 2] = 1.0
             elif not model.lower[kv] <= 0.0 <= model.upper[kv]:
                 q0[k] = 0.5 * (model.lower[kv] + model.upper[kv])
     if target is None and model.nq == model.nv:

@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..algorithms.regressor import EXTRA_COLUMNS, extra_columns, regressor
-from ..joints import QUAT_OFFSET
+from ..joints import NQ
 from ..random import random_configuration
 from ._blas import one_blas_thread
 
@@ -50,7 +50,7 @@ def random_states(model, n: int, rng: np.random.Generator):
     velocities and accelerations standard normal."""
     q = random_configuration(model, rng, n)
     for i in range(model.nbodies):
-        if QUAT_OFFSET[model.joint_type[i]] >= 0:  # free and spherical joints stay as drawn
+        if NQ[model.joint_type[i]] > 1:  # free, spherical and planar joints stay as drawn
             continue
         k, kv = model.idx_q[i], model.idx_v[i]
         lo, hi = model.lower[kv], model.upper[kv]

@@ -58,7 +58,7 @@ _CONTINUOUS = ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModel
 _PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismaticUnaligned")
 # Pinocchio joint type -> robodyn joint type
 _FROM_PIN = {**dict.fromkeys(_REVOLUTE + _CONTINUOUS, J.REVOLUTE), **dict.fromkeys(_PRISMATIC, J.PRISMATIC),
-             "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL,
+             "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL, "JointModelPlanar": J.PLANAR,
              **dict.fromkeys(("JointModelHX", "JointModelHY", "JointModelHZ", "JointModelHelicalUnaligned"), J.HELICAL)}
 
 # Symmetric per-dof bounds: robodyn field, Pinocchio's name (the upper bound in Pinocchio >= 4),
@@ -107,6 +107,8 @@ def _pin_joint(pin, jtype: int, axis: np.ndarray, pitch: float = 0.0):
         return pin.JointModelFreeFlyer()
     if jtype == J.SPHERICAL:
         return pin.JointModelSpherical()
+    if jtype == J.PLANAR:
+        return pin.JointModelPlanar()
     aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
                J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}[jtype]
     k = int(np.argmax(np.abs(axis)))
@@ -162,7 +164,7 @@ def to_pinocchio(model: Model):
                           pin.FrameType.BODY)
         pm.addFrame(frame, False)
 
-    one_dof = J.QUAT_OFFSET[model.joint_type] < 0  # free and spherical joints keep Pinocchio's default limits
+    one_dof = J.NQ[model.joint_type] == 1  # free, spherical, planar joints keep Pinocchio's default limits
     lower, upper = pm.lowerPositionLimit.copy(), pm.upperPositionLimit.copy()
     lower[model.idx_q[one_dof]] = _to_pin_bound(model.lower[model.idx_v[one_dof]])
     upper[model.idx_q[one_dof]] = _to_pin_bound(model.upper[model.idx_v[one_dof]])
@@ -201,7 +203,7 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
             raise ModelError(f"{source}: joint {name!r} is a JointModelFreeFlyer below joint "
                              f"{pm.names[pm.parents[j]]!r}; robodyn's free joint must attach to the world")
         return jtype, np.zeros(3), 0.0
-    if jtype == J.SPHERICAL:
+    if jtype in (J.SPHERICAL, J.PLANAR):
         return jtype, np.zeros(3), 0.0
     jd = jm.createData()
     jm.calc(jd, np.zeros(jm.nq))  # a helical joint's data holds S only once computed

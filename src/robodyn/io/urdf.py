@@ -1,8 +1,9 @@
 """URDF loader: ``load_urdf(path_or_xml_string, floating_base=False) -> Model``.
 
 Reads links (``<inertial>`` with origin xyz/rpy applied as ``R I R^T``), and joints of type
-revolute, continuous, prismatic, fixed (merged into the parent body) and floating (a free
-joint; its parent link must be the root or welded to it), with ``<origin>``,
+revolute, continuous, prismatic, fixed (merged into the parent body), floating (a free
+joint; its parent link must be the root or welded to it) and planar (with ``<axis xyz="0 0
+1">``, the plane's normal), with ``<origin>``,
 ``<axis>`` (normalised; zero is an error), ``<limit lower upper velocity effort>`` (lower and
 upper default to 0 as in the URDF specification; a joint without ``<limit>`` is unbounded,
 continuous joints always are), ``<dynamics damping friction>``.
@@ -183,14 +184,16 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
         raise ModelError(f"{where}: joint without a name")
     if jtype is None:
         raise ModelError(f"{where}: joint without a type")
-    if jtype == "planar":
-        raise ModelError(f"{where}: joint type 'planar' is not supported yet")
     if jtype == "floating":
         jtype = "free"  # the builder checks that its parent link is welded to the world
     parent = rd.required_child(elem, "parent", "link")
     child = rd.required_child(elem, "child", "link")
     xyz, rpy = rd.origin(elem)
     axis = rd.floats(_child(elem, "axis"), "xyz", 3, (1.0, 0.0, 0.0))
+    if jtype == "planar" and not (np.linalg.norm(axis) > 0 and np.allclose(axis / np.linalg.norm(axis), (0, 0, 1),
+                                                                           rtol=0, atol=1e-12)):
+        raise ModelError(f"{where}: planar joint with axis {axis.tolist()}: only the joint frame's z axis is "
+                         "supported as the plane's normal (turn the joint's origin so that it is z)")
     lim = _child(elem, "limit")
     dyn = _child(elem, "dynamics")
     kw = {}

@@ -98,6 +98,17 @@ def write_urdf(model, path=None) -> str:
                              "express")
         if jt == J.FREE and i == 0 and floating:
             continue
+        if jt == J.PLANAR:
+            lines += [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
+                      f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"planar\">",
+                      f"    <parent link={quoteattr(link_of(model.parent[i]))}/>",
+                      f"    <child link={quoteattr(model.link_names[i])}/>",
+                      f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}", '    <axis xyz="0.0 0.0 1.0"/>']
+            k = model.idx_v[i]
+            if np.any(model.damping[k:k + 3]) or np.any(model.coulomb[k:k + 3]):
+                lost.append(f"damping and friction of the planar joint {model.body_joint_names[i]!r}")
+            lines.append("  </joint>")
+            continue
         if jt == J.FREE:  # another free body: a floating joint under the fixed world
             if floating:
                 raise ValueError(f"write_urdf: free joint {model.body_joint_names[i]!r} beside a floating base, "

@@ -4,7 +4,9 @@ derivative, and whole runs of the uncontrolled robot.
 One step from ``(q_n, v_n)`` integrates in the chart ``q = q_n ⊞ theta`` centred at ``q_n``
 (Runge-Kutta-Munthe-Kaas, Hairer, Lubich and Wanner, *Geometric Numerical Integration*,
 section IV.8): 1-dof joints ``q_n + theta``; a free joint's position ``p_n + theta_p`` (parent
-coordinates) and orientation ``R_n exp(phi)``. The chart's derivative is exact::
+coordinates) and orientation ``R_n exp(phi)`` (a spherical joint's orientation alike; a planar
+joint's position ``(x, y) + theta_xy`` and angle ``t + theta_t``, whose rates are
+``Rz(t) (vx, vy)`` and ``wz``). The chart's derivative is exact::
 
     theta_p' = R(q) v_lin,    phi' = dexp^-1(phi) omega = omega + phi x omega / 2
                                                  + c(t) phi x (phi x omega),
@@ -25,7 +27,8 @@ from ..control.laws import law_torque
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..joints import FREE, SPHERICAL
+from ..joints import FREE, PLANAR, SPHERICAL
+from ..sincos import sincos
 from ..spatial import rotation_from_quaternion
 
 SEMI_IMPLICIT_EULER = 0
@@ -36,6 +39,13 @@ def chart_point(ints, q0, theta, q):
     """``q = q0 ⊞ theta`` (see the module docstring)."""
     for i in range(ints.shape[0]):
         jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
+        if jt == PLANAR:  # (x, y) + theta_xy, the angle + theta_t
+            q[iq], q[iq + 1] = q0[iq] + theta[iv], q0[iq + 1] + theta[iv + 1]
+            st, ct = sincos(theta[iv + 2])
+            c, s = q0[iq + 2] * ct - q0[iq + 3] * st, q0[iq + 3] * ct + q0[iq + 2] * st
+            n = np.sqrt(c * c + s * s)
+            q[iq + 2], q[iq + 3] = c / n, s / n
+            continue
         if jt != FREE and jt != SPHERICAL:
             q[iq] = q0[iq] + theta[iv]
             continue
@@ -62,6 +72,10 @@ def chart_rate(ints, q, theta, v, R, out):
     """``out = d theta / dt`` for velocity ``v`` at ``q = q0 ⊞ theta``; ``R`` is 3 x 3 workspace."""
     for i in range(ints.shape[0]):
         jt, iq, iv = ints[i, JTYPE], ints[i, IQ], ints[i, IV]
+        if jt == PLANAR:  # (x, y)' = Rz(t) (vx, vy), t' = wz
+            c, s = q[iq + 2], q[iq + 3]
+            out[iv], out[iv + 1], out[iv + 2] = c * v[iv] - s * v[iv + 1], s * v[iv] + c * v[iv + 1], v[iv + 2]
+            continue
         if jt != FREE and jt != SPHERICAL:
             out[iv] = v[iv]
             continue

@@ -38,7 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
-from ..algorithms.integrate import check_configurations
+from ..algorithms.integrate import TWIST_COMPONENTS, check_configurations, joint_pose, joint_twist, set_joint_pose
 from ..lie import exp_se3, exp_so3, inverse_jacobian_coefficients, quat_matrix, quat_mul, right_jacobian_so3, skew
 from .simulate import INTEGRATORS
 
@@ -68,37 +68,45 @@ def _chart(model, q0, theta, v):
     Dq0, Dth, Kv = eye.copy(), eye.copy(), eye.copy()
     Kq, Kth = np.zeros_like(Dq0), np.zeros_like(Dq0)
     q, k = q0.copy(), v.copy()
-    one = J.QUAT_OFFSET[model.joint_type] < 0
+    one = J.NQ[model.joint_type] == 1
     q[..., model.idx_q[one]] += theta[..., model.idx_v[one]]
-    for i in np.flatnonzero(~one):  # free and spherical joints: a rotation (and a translation)
-        free = model.joint_type[i] == J.FREE
-        iq, iv = model.idx_q[i], model.idx_v[i]
-        kq, ang = (iq + 3, slice(iv + 3, iv + 6)) if free else (iq, slice(iv, iv + 3))
-        phi, w = theta[..., ang], v[..., ang]
-        quat = quat_mul(q0[..., kq:kq + 4], exp_se3(np.concatenate([np.zeros_like(phi), phi], -1))[0])
+    lin, ang = slice(0, 3), slice(3, 6)
+    for i in np.flatnonzero(~one):
+        # free, spherical and planar joints: the free joint's chart in SE(3) coordinates, whose
+        # blocks restricted to the joint's twist components are the joint's (the spherical and
+        # planar motions are subgroups the chart maps into themselves)
+        kind, iq, iv = int(model.joint_type[i]), model.idx_q[i], model.idx_v[i]
+        sel = TWIST_COMPONENTS[kind]
+        th, vv = joint_twist(theta, iv, kind), joint_twist(v, iv, kind)
+        p0, quat0 = joint_pose(q0, iq, kind)
+        phi, w, vl = th[..., ang], vv[..., ang], vv[..., lin]
+        quat = quat_mul(quat0, exp_se3(np.concatenate([np.zeros_like(phi), phi], -1))[0])
         quat /= np.linalg.norm(quat, axis=-1, keepdims=True)
-        q[..., kq:kq + 4] = quat
+        set_joint_pose(q, iq, kind, p0 + th[..., lin], quat)
         R, E, Jr = quat_matrix(quat), exp_so3(phi), right_jacobian_so3(phi)
         Et, P, W = np.swapaxes(E, -1, -2), skew(phi), skew(w)
         t = np.linalg.norm(phi, axis=-1)
         c, dc = inverse_jacobian_coefficients(t)
         c, dc = c[..., None, None], dc[..., None, None]
         Jr_inv = np.eye(3) + 0.5 * P + c * (P @ P)
-        k[..., ang] = np.einsum("...ij,...j->...i", Jr_inv, w)
         ppw = (P @ P @ w[..., None])  # phi x (phi x w), (..., 3, 1)
         pw = np.sum(phi * w, -1)[..., None, None]
-        Dq0[..., ang, ang], Dth[..., ang, ang], Kv[..., ang, ang] = Et, Jr, Jr_inv
-        Kth[..., ang, ang] = (-0.5 * W + c * (pw * np.eye(3) + phi[..., :, None] * w[..., None, :]
+        RV = R @ skew(vl)
+        k6 = np.concatenate([np.einsum("...ij,...j->...i", R, vl), np.einsum("...ij,...j->...i", Jr_inv, w)], -1)
+        blocks = [np.zeros(th.shape[:-1] + (6, 6)) for _ in range(5)]  # Dq0, Dth, Kq, Kth, Kv
+        D0, Dt, Kq6, Kt6, Kv6 = blocks
+        D0[..., lin, lin], D0[..., ang, ang] = Et, Et
+        Dt[..., lin, lin], Dt[..., ang, ang] = np.swapaxes(R, -1, -2), Jr
+        Kv6[..., lin, lin], Kv6[..., ang, ang] = R, Jr_inv
+        Kq6[..., lin, ang] = -RV @ Et
+        Kt6[..., lin, ang] = -RV @ Jr
+        Kt6[..., ang, ang] = (-0.5 * W + c * (pw * np.eye(3) + phi[..., :, None] * w[..., None, :]
                                               - 2.0 * w[..., :, None] * phi[..., None, :])
                               + dc * ppw * phi[..., None, :])
-        if free:
-            lin, vl = slice(iv, iv + 3), v[..., iv:iv + 3]
-            q[..., iq:iq + 3] = q0[..., iq:iq + 3] + theta[..., lin]
-            k[..., lin] = np.einsum("...ij,...j->...i", R, vl)
-            RV = R @ skew(vl)
-            Dq0[..., lin, lin], Dth[..., lin, lin], Kv[..., lin, lin] = Et, np.swapaxes(R, -1, -2), R
-            Kq[..., lin, ang] = -RV @ Et
-            Kth[..., lin, ang] = -RV @ Jr
+        block = slice(iv, iv + len(sel))
+        k[..., block] = k6[..., sel]
+        for M, B in zip((Dq0, Dth, Kq, Kth, Kv), blocks):
+            M[..., block, block] = B[..., sel, :][..., sel]
     return q, k, Dq0, Dth, Kq, Kth, Kv
 
 

@@ -192,12 +192,13 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if cmodel is not None and (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
-    for i in np.flatnonzero(J.QUAT_OFFSET[model.joint_type] >= 0):
-        k = model.idx_q[i] + J.QUAT_OFFSET[model.joint_type[i]]
-        n = np.linalg.norm(q0[k:k + 4])
+    for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
+        k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
+        n = np.linalg.norm(q0[k:k + size])
         if abs(n - 1.0) > J.QUAT_TOL:
-            raise ValueError(f"q0: quaternion q0[{k}:{k + 4}] has norm {n:.6g}, not 1; normalise it")
-        q0[k:k + 4] /= n
+            unit = "quaternion" if size == 4 else "(cos, sin)"
+            raise ValueError(f"q0: {unit} q0[{k}:{k + size}] has norm {n:.6g}, not 1; normalise it")
+        q0[k:k + size] /= n
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
     Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))

@@ -189,7 +189,7 @@ def from_model(model) -> SymbolicModel:
     (module docstring). Revolute and prismatic joints on a fixed base only."""
     if isinstance(model, SymbolicModel):
         return model
-    for kind in (J.SPHERICAL, J.HELICAL):
+    for kind in (J.SPHERICAL, J.HELICAL, J.PLANAR):
         if np.any(model.joint_type == kind):
             raise ModelError(f"model {model.name!r} has a {J.NAMES[kind]} joint; robodyn.symbolic derives "
                              "fixed-base trees of revolute and prismatic joints only")
