@@ -44,7 +44,7 @@ def test_unknown_joint_type():
 def test_custom_where_is_used():
     b = _builder("a", "b")
     with pytest.raises(rd.ModelError, match=r"^file.urdf: <joint name='j'> \(line 7\): unknown joint type"):
-        b.add_joint("j", "universal", "a", "b", where="file.urdf: <joint name='j'> (line 7)")
+        b.add_joint("j", "cardan", "a", "b", where="file.urdf: <joint name='j'> (line 7)")
 
 
 @pytest.mark.parametrize("parent, child, what", [

@@ -147,6 +147,34 @@ def test_planar_body_closed_form():
         rd.rnea(model, [0, 0, 2.0, 0], np.zeros(3), np.zeros(3))
 
 
+def test_universal_joint_is_pinocchios():
+    """A universal joint, built as two revolute joints on a massless cross, has the dynamics of
+    Pinocchio's JointModelUniversal (same q and v)."""
+    rng = rng_for("universal")
+    a1, a2 = np.array([1.0, 0, 0]), np.array([0, 0.6, 0.8])
+    placement = pin.SE3(pin.utils.rpyToMatrix(0.1, -0.2, 0.3), np.array([0.1, 0.2, 0.3]))
+    inertia = pin.Inertia(1.5, np.array([0.1, -0.05, 0.2]), np.diag([0.02, 0.03, 0.04]))
+    pm = pin.Model()
+    j = pm.addJoint(0, pin.JointModelUniversal(a1, a2), placement, "cardan")
+    pm.appendBodyToJoint(j, inertia, pin.SE3.Identity())
+    b = rd.ModelBuilder("cardan")
+    b.add_link("base")
+    b.add_link("shaft", mass=1.5, com=inertia.lever, inertia=inertia.inertia)
+    b.add_joint("cardan", "universal", "base", "shaft", xyz=placement.translation, rotation=placement.rotation,
+                axis=a1, axis2=a2, lower=(-1, -2), upper=(1, 2), damping=0.3)
+    model = b.build()
+    assert model.joint_names == ("cardan[1]", "cardan[2]") and model.link_names == ("shaft:cardan", "shaft")
+    assert model.lower.tolist() == [-1, -2] and model.damping.tolist() == [0.3, 0.3]
+    q, v, a = rng.standard_normal(2), rng.standard_normal(2), rng.standard_normal(2)
+    pd = pm.createData()
+    assert_rel(rd.rnea(model, q, v, a, friction=False), pin.rnea(pm, pd, q, v, a), 1e-12, "rnea")
+    assert_rel(rd.crba(model, q), pin.crba(pm, pd, q), 1e-12, "crba")
+    with pytest.raises(rd.ModelError, match="are parallel"):
+        b.add_joint("bad", "universal", "base", "shaft", axis=a1, axis2=2 * a1)
+    with pytest.raises(rd.ModelError, match="needs axis2"):
+        b.add_joint("bad", "universal", "base", "shaft")
+
+
 def spherical_pendulum():
     b = rd.ModelBuilder("spherical_pendulum")
     b.add_link("pivot")

@@ -146,7 +146,7 @@ class ModelBuilder:
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
                   upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
-                  armature=0.0, pitch: float = 0.0, where: str | None = None) -> None:
+                  armature=0.0, pitch: float = 0.0, axis2=None, where: str | None = None) -> None:
         """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
         in the parent link frame and the child frame coincides with it at ``q = 0``.
 
@@ -156,10 +156,20 @@ class ModelBuilder:
         plane and turns about its z axis), ``spherical`` (a ball
         joint: ``q = [qx, qy, qz, qw]`` rotates the child in the joint frame) or ``free`` (a
         6-dof joint, whose parent link must be the root or welded to it: its configuration
-        ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame)."""
+        ``[x, y, z, qx, qy, qz, qw]`` places the child in the joint frame).
+
+        ``universal`` (a Cardan joint): a rotation ``q1`` about ``axis``, then ``q2`` about
+        ``axis2`` in the turned frame, ``R = Rot(axis, q1) Rot(axis2, q2)`` as Pinocchio's
+        ``JointModelUniversal``. It is built exactly as two revolute joints ``name[1]`` and
+        ``name[2]`` on a massless cross link ``child:name``; the limits, damping, friction and
+        armature may be scalars or pairs."""
         where = where or f"{self.source}: joint {name!r}"
+        if type == "universal":
+            return self._add_universal(name, parent, child, xyz, rpy, axis, axis2, rotation, where,
+                                       dict(lower=lower, upper=upper, velocity=velocity, effort=effort,
+                                            damping=damping, friction=friction, armature=armature))
         if type not in JOINT_TYPES:
-            raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted(JOINT_TYPES)}")
+            raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted([*JOINT_TYPES, 'universal'])}")
         rot = np.asarray(rpy if rotation is None else rotation, dtype=float)
         p = np.asarray(xyz, dtype=float).reshape(3)
         ax = np.asarray(axis, dtype=float).reshape(3)
@@ -189,6 +199,25 @@ class ModelBuilder:
         if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
             raise ModelError(f"{where}: pitch {pitch} on a {type} joint (only a helical joint has a finite pitch)")
         self._joints.append(_Joint(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
+
+    def _add_universal(self, name, parent, child, xyz, rpy, axis, axis2, rotation, where, options) -> None:
+        if axis2 is None:
+            raise ModelError(f"{where}: a universal joint needs axis2")
+        a1, a2 = (np.asarray(a, dtype=float).reshape(3) for a in (axis, axis2))
+        n1, n2 = np.linalg.norm(a1), np.linalg.norm(a2)
+        if not (np.all(np.isfinite(a1)) and np.all(np.isfinite(a2)) and n1 > 0 and n2 > 0):
+            raise ModelError(f"{where}: universal joint axes must be finite and non-zero, got {a1.tolist()}, {a2.tolist()}")
+        if np.linalg.norm(np.cross(a1 / n1, a2 / n2)) < 1e-9:
+            raise ModelError(f"{where}: universal joint axes {a1.tolist()} and {a2.tolist()} are parallel")
+        try:
+            split = [{k: float(np.broadcast_to(np.asarray(v, dtype=float), (2,))[j]) for k, v in options.items()}
+                     for j in (0, 1)]
+        except ValueError:
+            raise ModelError(f"{where}: universal joint limits and friction must be scalars or pairs") from None
+        cross = f"{child}:{name}"
+        self.add_link(cross, where=where)
+        self.add_joint(f"{name}[1]", "revolute", parent, cross, xyz, rpy, a1, rotation=rotation, where=where, **split[0])
+        self.add_joint(f"{name}[2]", "revolute", cross, child, axis=a2, where=where, **split[1])
 
     # ---------------------------------------------------------------------------------
     def _check_graph(self) -> tuple[str, dict[str, list[_Joint]]]:
