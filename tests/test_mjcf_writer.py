@@ -101,6 +101,14 @@ def test_what_mjcf_cannot_hold():
     b.add_joint("free", "free", "world", "box", xyz=(0, 0, 1))
     with pytest.raises(ValueError, match="free joint 'free' has a placement in the world"):
         rd.write_mjcf(b.build())
+    b = rd.ModelBuilder("massless base")
+    b.add_link("world")
+    b.add_link("base")
+    b.add_link("arm", mass=1.0, com=(0.1, 0, 0), inertia=np.eye(3) * 0.01)
+    b.add_joint("free", "free", "world", "base")
+    b.add_joint("hinge", "revolute", "base", "arm")
+    with pytest.raises(ValueError, match="body 'base' moves without mass"):  # a free body merges no joint
+        rd.write_mjcf(b.build())
     ball = rd.ModelBuilder("ball")
     ball.add_link("world")
     ball.add_link("bob", mass=1.0, com=(0, 0, -1), inertia=np.eye(3) * 0.01)

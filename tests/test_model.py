@@ -8,7 +8,7 @@ import pytest
 import robodyn as rd
 from conftest import small_tree_builder
 from robodyn import joints as J
-from robodyn.model import Model, check_inertial_parameters, inertial_parameters_from
+from robodyn.model import Model, check_inertial_parameters, consistent_inertial_parameters, inertial_parameters_from
 
 
 @pytest.fixture(scope="module")
@@ -294,3 +294,33 @@ def test_unphysical_bodies_fail(Ic, what):
 def test_inertial_parameters_from_parallel_axis():
     theta = inertial_parameters_from(2.0, (1.0, 0.0, 0.0), np.diag([0.1, 0.2, 0.3]))
     np.testing.assert_allclose(theta, [2.0, 2.0, 0.0, 0.0, 0.1, 0.0, 2.2, 0.0, 0.0, 2.3])
+
+
+def test_vectorised_inertia_check_agrees_with_the_scalar_one():
+    """``consistent_inertial_parameters`` (every body at once, a filter before the per-body
+    messages) accepts exactly what ``check_inertial_parameters`` accepts, on bodies around every
+    boundary: massless, negative mass, non-finite, not PSD, triangle inequality just met or not."""
+    rng = np.random.default_rng(7)
+    bodies = []
+    for _ in range(400):
+        m = rng.choice([0.0, -0.5, 1e-9, 2.0])
+        d = rng.uniform(0.0, 1.0, 3)
+        d[2] = d[0] + d[1] + rng.choice([-1e-3, -1e-9, 0.0, 1e-9, 1e-3])  # around I1 + I2 = I3
+        d[rng.integers(3)] *= rng.choice([1.0, 1.0, -1e-3])  # sometimes not PSD
+        R = np.linalg.qr(rng.standard_normal((3, 3)))[0]
+        theta = inertial_parameters_from(max(m, 0.0), rng.uniform(-1, 1, 3), R @ np.diag(d) @ R.T)
+        theta[0] = m
+        if rng.random() < 0.05:
+            theta[rng.integers(10)] = rng.choice([np.nan, np.inf])
+        if m == 0 and rng.random() < 0.5:
+            theta[1:] = 0.0
+        bodies.append(theta)
+    mask = consistent_inertial_parameters(np.array(bodies))
+    for theta, ok in zip(bodies, mask):
+        try:
+            check_inertial_parameters(theta, "body")
+            scalar = True
+        except rd.ModelError:
+            scalar = False
+        assert ok == scalar, theta
+    assert 50 < mask.sum() < 350  # both kinds occur

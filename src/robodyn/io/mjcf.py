@@ -51,7 +51,7 @@ import numpy as np
 
 from ..builder import ModelBuilder
 from ..errors import ModelError, RobodynWarning
-from ..lie import quat_matrix
+from ..lie import exp_so3, quat_matrix
 from ..model import Model
 from ._xml import is_xml_text, parse, read_source
 
@@ -298,19 +298,8 @@ def _compose(a, b):
 
 
 def _axis_rotation(axis, angle) -> np.ndarray:
-    k = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * k + (1 - np.cos(angle)) * (k @ k)
-
-
-def _quat(w, x, y, z) -> np.ndarray:
-    return np.array([w, x, y, z], dtype=float)
-
-
-def _quat_mul(a, b) -> np.ndarray:
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return _quat(w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                 w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2)
+    """Rotation by ``angle`` about the unit ``axis``."""
+    return exp_so3(np.asarray(axis, dtype=float) * angle)
 
 
 def _z_to(vec) -> np.ndarray:
@@ -362,12 +351,11 @@ class _Bodies:
             return _axis_rotation(v[:3] / n, v[3] * unit)
         if kind == "euler":
             e = doc.floats(elem, a, "euler", 3) * unit
-            q = _quat(1, 0, 0, 0)
-            for ch, angle in zip(self.c.eulerseq, e):
-                r = _quat(np.cos(angle / 2), 0, 0, 0)
-                r["xyz".index(ch.lower()) + 1] = np.sin(angle / 2)
-                q = _quat_mul(q, r) if ch.islower() else _quat_mul(r, q)
-            return quat_matrix(np.r_[q[1:], q[0]] / np.linalg.norm(q))
+            R = np.eye(3)
+            for ch, angle in zip(self.c.eulerseq, e):  # lower case: about the turned axes
+                Ri = _axis_rotation(np.eye(3)["xyz".index(ch.lower())], angle)
+                R = R @ Ri if ch.islower() else Ri @ R
+            return R
         if kind == "xyaxes":
             v = doc.floats(elem, a, "xyaxes", 6)
             x, y = v[:3], v[3:]

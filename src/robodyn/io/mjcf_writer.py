@@ -16,11 +16,12 @@ written as one MuJoCo body with several joints: with ``C_j`` the placement of th
 body in body ``j``'s frame at ``q = 0``, joint ``j`` sits at ``C_j^-1``'s origin with axis
 ``R_Cj^T a_j`` in the last body's frame, so that MuJoCo's product of rotations about anchors,
 in order, is the chain's ``X_1 J_1 X_2 J_2 ... X_n J_n``. Any other massless moving body raises
-``ValueError``, as do one-sided position limits and free joints below the world or with a
-placement. Velocity and effort limits and Coulomb smoothing, which MJCF joints do not hold, are
-reported in a :class:`~robodyn.errors.RobodynWarning`, as are principal moments of inertia
-below ``1e-12`` of the model's largest (point masses, which MuJoCo refuses): the file raises
-them to that bound with ``<compiler boundinertia>``.
+``ValueError`` (a massless body on a free joint too: it merges no joint), as do one-sided
+position limits and free joints placed away from the world origin. Velocity and effort
+limits and Coulomb smoothing, which MJCF joints do not hold, are reported in a
+:class:`~robodyn.errors.RobodynWarning`, as are principal moments of inertia below ``1e-12``
+of the model's largest (point masses, which MuJoCo refuses): the file raises them to that
+bound with ``<compiler boundinertia>``.
 """
 
 from __future__ import annotations
@@ -75,6 +76,8 @@ class _Writer:
     def chain(self, i) -> list[int]:
         """Body ``i`` and the massless, frameless single children after it (see the module)."""
         out = [i]
+        if self.m.joint_type[i] == J.FREE:  # a <freejoint> body holds no other joint
+            return out
         while (self.massless(out[-1]) and not self.frames[out[-1]] and len(self.children[out[-1]]) == 1
                and self.m.joint_type[self.children[out[-1]][0]] != J.FREE):
             out.append(self.children[out[-1]][0])
@@ -122,8 +125,7 @@ class _Writer:
             C.insert(0, (m.X_tree_R[b] @ R, m.X_tree_R[b] @ p + m.X_tree_p[b]))
         R0, p0 = m.X_tree_R[i] @ C[0][0], m.X_tree_R[i] @ C[0][1] + m.X_tree_p[i]
         if m.joint_type[i] == J.FREE:
-            if m.parent[i] >= 0 or not (np.allclose(m.X_tree_R[i], np.eye(3), rtol=0, atol=0)
-                                        and not np.any(m.X_tree_p[i])):
+            if not (np.array_equal(m.X_tree_R[i], np.eye(3)) and not np.any(m.X_tree_p[i])):
                 raise ValueError(f"write_mjcf: free joint {m.body_joint_names[i]!r} has a placement in the world; "
                                  "MuJoCo places a free body by its qpos alone")
             self.lines.append(f"{indent}<body name={quoteattr(m.link_names[i])}>")

@@ -64,6 +64,14 @@ def _inertial(theta) -> list[str]:
             "    </inertial>"]
 
 
+def _link_and_joint(model, i: int, kind: str, parent: str) -> list[str]:
+    """Body ``i``'s link, and its joint's opening up to the origin (the caller closes it)."""
+    return [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
+            f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"{kind}\">",
+            f"    <parent link={quoteattr(parent)}/>", f"    <child link={quoteattr(model.link_names[i])}/>",
+            f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}"]
+
+
 def write_urdf(model, path=None) -> str:
     """The URDF text of ``model`` (module docstring); also written to ``path`` if given."""
     lost = []
@@ -99,11 +107,8 @@ def write_urdf(model, path=None) -> str:
         if jt == J.FREE and i == 0 and floating:
             continue
         if jt == J.PLANAR:
-            lines += [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
-                      f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"planar\">",
-                      f"    <parent link={quoteattr(link_of(model.parent[i]))}/>",
-                      f"    <child link={quoteattr(model.link_names[i])}/>",
-                      f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}", '    <axis xyz="0.0 0.0 1.0"/>']
+            lines += _link_and_joint(model, i, "planar", link_of(model.parent[i]))
+            lines.append('    <axis xyz="0.0 0.0 1.0"/>')
             k = model.idx_v[i]
             if np.any(model.damping[k:k + 3]) or np.any(model.coulomb[k:k + 3]):
                 lost.append(f"damping and friction of the planar joint {model.body_joint_names[i]!r}")
@@ -113,10 +118,7 @@ def write_urdf(model, path=None) -> str:
             if floating:
                 raise ValueError(f"write_urdf: free joint {model.body_joint_names[i]!r} beside a floating base, "
                                  "which URDF cannot express (one tree from one root link)")
-            lines += [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
-                      f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"floating\">",
-                      f"    <parent link={quoteattr(root)}/>", f"    <child link={quoteattr(model.link_names[i])}/>",
-                      f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}", "  </joint>"]
+            lines += _link_and_joint(model, i, "floating", root) + ["  </joint>"]
             continue
         k = model.idx_v[i]
         lo, hi = model.lower[k], model.upper[k]
@@ -125,13 +127,7 @@ def write_urdf(model, path=None) -> str:
             raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} has a one-sided position limit "
                              f"[{lo}, {hi}], which URDF cannot express")
         kind = ("revolute" if bounded else "continuous") if jt == J.REVOLUTE else "prismatic"
-        lines.append(f"  <link name={quoteattr(model.link_names[i])}>")
-        lines += _inertial(model.inertia[i])
-        lines.append("  </link>")
-        lines.append(f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"{kind}\">")
-        lines.append(f"    <parent link={quoteattr(link_of(model.parent[i]))}/>")
-        lines.append(f"    <child link={quoteattr(model.link_names[i])}/>")
-        lines.append(f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}")
+        lines += _link_and_joint(model, i, kind, link_of(model.parent[i]))
         lines.append(f'    <axis xyz="{_num(model.joint_axis[i])}"/>')
         attrs = f'lower="{_num(lo)}" upper="{_num(hi)}" ' if bounded else ""
         for key, val in (("velocity", model.velocity_limit[k]), ("effort", model.effort_limit[k])):
