@@ -34,7 +34,8 @@ _LAZY = {
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation", "simulation": None,
-              "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None}
+              "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
+              "contact": None, "Contacts": "contact"}
 
 
 def __getattr__(name):
@@ -77,6 +78,7 @@ __all__ = [
     "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
     "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",
+    "contact", "Contacts",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

@@ -62,8 +62,10 @@ def _algorithm_steps(rd, model, q, v, a):
 def _simulation_steps(rd, model):
     """``(name, call)`` of short simulations that compile every simulation kernel: the compiled
     runs (no controller, PD with gravity compensation, computed torque; both fixed-step
-    integrators) and the Python-driven stages (a controller in Python, task-space PD)."""
+    integrators) and the Python-driven stages (a controller in Python, task-space PD), with
+    and without contacts."""
     from . import control
+    from .contact import Contacts, Plane, Sphere
     from .random import random_configuration
 
     q0, v0 = random_configuration(model, np.random.default_rng(0)), np.zeros(model.nv)
@@ -77,8 +79,12 @@ def _simulation_steps(rd, model):
     run = [("simulate", None, "rk4"), ("simulate (semi-implicit Euler)", None, "semi_implicit_euler"),
            ("simulate (PDGravity)", pd, "rk4"), ("simulate (ComputedTorque)", ct, "rk4"),
            ("simulate (Python controller)", python_law, "rk4"), ("simulate (TaskSpacePD)", task, "rk4")]
-    return [(name, lambda c=c, i=i: rd.simulate(model, q0, v0, 0.004, 0.002, c, i, progress=False))
-            for name, c, i in run]
+    out = [(name, lambda c=c, i=i: rd.simulate(model, q0, v0, 0.004, 0.002, c, i, progress=False))
+           for name, c, i in run]
+    touch = Contacts([Sphere(model.nbodies - 1, 0.05)], surfaces=[Plane(height=10.0)])  # in contact from the start
+    return out + [(name, lambda c=c: rd.simulate(model, q0, v0, 0.004, 0.002, c, contacts=touch, progress=False))
+                  for name, c in (("simulate (contacts)", None), ("simulate (contacts, Python controller)",
+                                                                   python_law))]
 
 
 def _public():

@@ -14,12 +14,17 @@ from __future__ import annotations
 
 import sys
 import time
+import warnings
+from typing import NamedTuple
 
 import numpy as np
 
 from .. import joints as J
 from ..algorithms.status import OK, raise_for_status
+from ..contact import solver as CS
 from ..control.laws import CONSTANT
+from ..errors import RobodynWarning
+from . import _contact_step as CK
 from . import _kernels as K
 from .trajectory import Trajectory
 
@@ -126,11 +131,7 @@ class _Plant:
     def derivative(self, t, q, theta, v, law, z, tau, thetadot, a, zdot):
         """``(theta', a, z')`` into the given arrays; the applied torque into ``tau``."""
         law.rate(t, q, v, z, zdot)
-        cmd = law.torque(t, q, v, z)
-        if type(cmd) is not np.ndarray or cmd.dtype != np.float64 or cmd.shape != (self.model.nv,):
-            cmd = np.asarray(cmd, dtype=float)
-            if cmd.shape != (self.model.nv,):
-                raise ValueError(f"controller: returned shape {cmd.shape} at t = {t}, expected ({self.model.nv},)")
+        cmd = _command(law, t, q, v, z, self.model.nv)
         status = K.stage(*self.args, q, np.ascontiguousarray(theta), np.ascontiguousarray(v), cmd, tau, thetadot, a,
                          self.ws, self.R)
         if status != OK:
@@ -147,8 +148,8 @@ def _raise(model, status, t, q, v, tau):
                      f"({model.link_names[bad - 1]!r}) is singular; the forward dynamics is undefined")
 
 
-def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str = "rk4", *,
-             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
+def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str | None = None, *,
+             contacts=None, rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
     """Simulate the robot from ``(q0, v0)`` for ``duration`` seconds, sampled every ``dt``.
 
     Args:
@@ -162,10 +163,17 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             A controller with an internal state (``state0`` (nz,), e.g. integral action or
             parameter estimates) is called as ``torque(t, q, v, z)``, and its state is
             integrated with the robot from ``z' = state_rate(t, q, v, z)``.
-        integrator: ``"rk4"`` (classic 4th-order Runge-Kutta in the manifold chart),
-            ``"semi_implicit_euler"`` (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), or a SciPy
+        integrator: ``"rk4"`` (classic 4th-order Runge-Kutta in the manifold chart; the
+            default without contacts), ``"semi_implicit_euler"`` (the default and the only
+            one with contacts) (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), or a SciPy
             ``solve_ivp`` method (``"RK45"``, ``"DOP853"``, ``"Radau"``, ...), adaptive between
             samples with tolerances ``rtol``, ``atol``, restarted in a new chart at each sample.
+        contacts: a :class:`robodyn.contact.Contacts` (shapes on the bodies, surfaces of the
+            world, solver settings), or None. With contacts, every step solves the contact
+            impulses (unilateral, Coulomb friction cones, impacts: see
+            :mod:`robodyn.contact.solver`), and the trajectory holds each pair's contact
+            force and distance and the solver's sweeps and residual at every sample; a step
+            whose solve did not reach the tolerance is reported in one warning.
         progress: show a progress bar on stderr (None: when stderr is a terminal and the run
             has at least ``PROGRESS_STEPS`` steps).
 
@@ -184,6 +192,16 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     duration, dt = _positive("duration", duration), _positive("dt", dt)
     if dt > duration:
         raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
+    if contacts is not None:
+        from ..contact.geometry import Contacts
+
+        if not isinstance(contacts, Contacts):
+            raise ValueError(f"contacts: expected a robodyn.contact.Contacts or None, got {type(contacts).__name__}")
+        if integrator not in (None, "semi_implicit_euler"):
+            raise ValueError(f"integrator: {integrator!r} cannot step through impacts; with contacts the time "
+                             f"stepping is 'semi_implicit_euler' (the default)")
+    if integrator is None:
+        integrator = "rk4" if contacts is None else "semi_implicit_euler"
     if integrator not in INTEGRATORS + SCIPY_INTEGRATORS:
         raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS + SCIPY_INTEGRATORS}")
     if controller is not None and not callable(controller):
@@ -210,14 +228,17 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     compiled = None
     if integrator in INTEGRATORS and not law.stateful:
         compiled = (CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
-    if compiled is not None:
+    touch = None
+    if contacts is not None:
+        touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar)
+    elif compiled is not None:
         _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
     elif integrator in INTEGRATORS:
         _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
     else:
         _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
     bar.close()
-    return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T)
+    return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch)
 
 
 def _kernel_law(controller):
@@ -227,16 +248,23 @@ def _kernel_law(controller):
     return None if spec is None else (spec[0], controller.model, *spec[1:])
 
 
+def _law_arrays(model, compiled):
+    """``(c, law, gains, breaks, coefs)``: the arguments of ``laws.law_torque`` for a compiled law."""
+    law, cmodel, gains, breaks, coefs = compiled
+    if law == CONSTANT:
+        nv = model.nv
+        cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
+    k = cmodel.kernel
+    return (k.ints, k.body, k.dofs[False, False], k.dofs[True, True], k.params[True], k.zero_wrench), law, gains, \
+        breaks, coefs
+
+
 def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
     """Compiled runs (no controller, or a built-in one), in pieces of about 1% of the run
     when the progress bar is shown."""
-    law, cmodel, gains, breaks, coefs = compiled
     model = plant.model
     nv = model.nv
-    if law == CONSTANT:
-        cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
-    k = cmodel.kernel
-    c = (k.ints, k.body, k.dofs[False, False], k.dofs[True, True], k.params[True], k.zero_wrench)
+    c, law, gains, breaks, coefs = _law_arrays(model, compiled)
     n = Q.shape[0] - 1
     method = K.RK4 if integrator == "rk4" else K.SEMI_IMPLICIT_EULER
     zero = np.zeros(nv)
@@ -249,6 +277,78 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
         if status != OK:
             _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
         bar.update(b)
+
+
+class Touch(NamedTuple):
+    """The contact samples of a run: pair names, forces (N, npairs, 3), distances (N, npairs),
+    solver info (N, 3)."""
+    names: tuple
+    force: np.ndarray
+    distance: np.ndarray
+    info: np.ndarray
+
+
+def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar):
+    """Time stepping with contacts (see ``_contact_step``): compiled runs under a compiled
+    law (in pieces of about 1% of the run when the progress bar is shown), else one compiled
+    step per sample from a Python loop; warns when a solve did not converge."""
+    model = plant.model
+    (points, centers, radii), surf, settings, names = contacts.pack(model)
+    N, nv, nz = Q.shape[0], model.nv, Z.shape[1]
+    n = N - 1
+    touch = Touch(names, np.zeros((N, len(names), 3)), np.zeros((N, len(names))), np.zeros((N, CS.INFO_SIZE)))
+    warm = np.zeros((len(names), 3))
+    geometry = (points, centers, radii, surf, settings)
+    Q[0], V[0] = q0, v0
+    if compiled is not None:
+        c, code, gains, breaks, coefs = _law_arrays(model, compiled)
+        zero = np.zeros(nv)
+        piece = max(1, n // 100) if bar.enabled else n
+        for a in range(0, n, piece):
+            b = min(n, a + piece)
+            status, s = CK.run(*plant.args, c, code, gains, breaks, coefs, zero, *geometry, a, dt, b == n, Q[a:b + 1],
+                               V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.distance[a:b + 1],
+                               touch.info[a:b + 1], warm)
+            if status != OK:
+                _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
+            bar.update(b)
+    else:
+        ws = CK.workspace(model.nbodies, nv, len(names))
+        every = max(1, n // 100)
+        zdot = np.empty(nz)
+        for s in range(N):
+            q, v, z = Q[s], V[s], Z[s]
+            cmd = _command(law, t[s], q, v, z, nv)
+            law.rate(t[s], q, v, z, zdot)
+            qn, vn = (Q[s + 1], V[s + 1]) if s < n else (np.empty(model.nq), np.empty(nv))
+            status = CK.step_kernel(*plant.args, *geometry, q, v, cmd, dt, T[s], A[s], qn, vn, touch.force[s],
+                                    touch.distance[s], warm, touch.info[s], ws)
+            if status != OK:
+                _raise(model, status, t[s], q, v, cmd)
+            if s < n:
+                Z[s + 1] = z + dt * zdot
+            if s % every == 0:
+                bar.update(s)
+    residual = touch.info[:, CS.RESIDUAL]
+    bad = residual > contacts.warn_above
+    if bad.any():
+        worst = int(np.argmax(residual))
+        warnings.warn(f"simulate: the contact solver stopped above {contacts.warn_above:g} m/s in {int(bad.sum())} of "
+                      f"{N} steps (largest residual {residual[worst]:.3g} m/s at t = {t[worst]:.6g} after "
+                      f"{int(touch.info[worst, CS.ITERATIONS])} iterations; the tolerance is "
+                      f"{contacts.tolerance:g} m/s); raise Contacts.max_iterations or lower the time step",
+                      RobodynWarning, stacklevel=3)
+    return touch
+
+
+def _command(law, t, q, v, z, nv):
+    """The controller's command at ``(t, q, v, z)`` as a float64 (nv,) array."""
+    cmd = law.torque(t, q, v, z)
+    if type(cmd) is not np.ndarray or cmd.dtype != np.float64 or cmd.shape != (nv,):
+        cmd = np.asarray(cmd, dtype=float)
+        if cmd.shape != (nv,):
+            raise ValueError(f"controller: returned shape {cmd.shape} at t = {t}, expected ({nv},)")
+    return np.ascontiguousarray(cmd)
 
 
 def _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar):
@@ -321,7 +421,7 @@ def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
             bar.update(s)
 
 
-def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Trajectory:
+def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None) -> Trajectory:
     from ..algorithms.energy import kinetic_energy, potential_energy
 
     kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
@@ -344,4 +444,8 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T) -> Traject
             v_d = np.array([r[1] for r in ref], dtype=float)
     return Trajectory(model=model, t=t, q=Q, v=V, a=A, tau=T, kinetic=kinetic, potential=potential,
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
-                      controller_state=Z if law.stateful else None, integrator=integrator)
+                      controller_state=Z if law.stateful else None, integrator=integrator,
+                      **({} if touch is None else dict(
+                          contact_names=touch.names, contact_force=touch.force, contact_distance=touch.distance,
+                          solver_iterations=touch.info[:, CS.ITERATIONS].astype(np.int64),
+                          solver_residual=touch.info[:, CS.RESIDUAL])))

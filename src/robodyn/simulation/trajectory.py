@@ -24,6 +24,12 @@ class Trajectory:
     controller's Lyapunov function or None; ``q_desired``, ``v_desired`` (N, nq) / (N, nv)
     the controller's reference or None; ``controller_state`` (N, nz) the internal state of a
     controller that has one (see :func:`robodyn.simulate`), else None.
+
+    With contacts: ``contact_names`` the pairs ``"<shape>@<surface>"``; ``contact_force``
+    (N, npairs, 3) the force each pair's surface applies to the robot (world axes, N; zero
+    when apart), over the step that starts at the sample; ``contact_distance`` (N, npairs)
+    the signed distance (m, negative: penetration); ``solver_iterations`` (N,) and
+    ``solver_residual`` (N,) (m/s) of the contact solve.
     """
 
     model: object = field(repr=False)
@@ -40,6 +46,11 @@ class Trajectory:
     v_desired: np.ndarray | None = None
     controller_state: np.ndarray | None = None
     integrator: str = "rk4"
+    contact_names: tuple | None = None
+    contact_force: np.ndarray | None = None
+    contact_distance: np.ndarray | None = None
+    solver_iterations: np.ndarray | None = None
+    solver_residual: np.ndarray | None = None
 
     @property
     def tracking_error(self) -> np.ndarray | None:

@@ -1,0 +1,174 @@
+"""Compiled time stepping with contacts: one step (the model of :mod:`robodyn.contact.solver`)
+and whole runs under a compiled control law.
+
+A step from ``(q, v)`` under the command ``tau_cmd`` (clipped to the effort limits):
+``h = rnea(q, v, 0)``, ``M = crba(q) = L L^T``, the free velocity ``v_f``, the contact pairs
+within reach (a gap below ``margin`` plus the distance the free motion covers in the step),
+their Jacobian rows in their contact frames, the Delassus matrix, the impulses by projected
+Gauss-Seidel, then ``v+`` and ``q+ = q ⊞ dt v+`` in the chart of ``q`` (as
+``simulate``'s semi-implicit Euler).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import inline, kernel
+from ..algorithms.crba import crba_one
+from ..algorithms.crba import workspace as crba_workspace
+from ..algorithms.rnea import rnea_one
+from ..algorithms.rnea import workspace as rnea_workspace
+from ..algorithms.status import CHECKED, NO_WRENCH, NONFINITE_RESULT, OK, finite
+from ..contact.solver import (ACTIVE, BOUNCE_SPEED, ITERATIONS, MARGIN, MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL,
+                              STABILIZATION, TOLERANCE, backward, cholesky, contact_frame, delassus, forward, solve,
+                              point_rows)
+from ..control.laws import law_torque
+from ._kernels import chart_point, chart_rate
+
+
+@kernel
+def workspace(nb, nv, npairs):
+    """Scratch of :func:`step` for a model of ``nb`` bodies and ``nv`` dofs and ``npairs`` pairs."""
+    m3 = 3 * npairs
+    return (crba_workspace(nb, nv), rnea_workspace(nb), np.empty((nv, nv)), np.empty(nv), np.empty(nv),
+            np.zeros(nv), np.empty((m3, nv)), np.empty((nv, m3)), np.empty((m3, m3)), np.empty(m3),
+            np.empty(npairs), np.empty(npairs), np.empty(m3), np.empty((npairs, 3, 3)),
+            np.empty(npairs, np.int64), np.empty((3, 3)), np.empty(nv), np.empty(3),
+            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))))
+
+
+@inline
+def _dot(a, b):
+    s = 0.0
+    for k in range(a.shape[0]):
+        s += a[k] * b[k]
+    return s
+
+
+@inline
+def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+         tau, a, q1, v1, force, dist, warm, info, ws):
+    """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
+    state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
+    signed distance (m) at ``q``, the solver's ``info`` (sweeps, residual, active contacts;
+    converged when the residual is at most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous
+    step's impulses in the contact frames (read and written). Returns a status."""
+    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws = ws
+    nv = v.shape[0]
+    for k in range(nv):
+        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
+    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, NO_WRENCH, CHECKED, h, rws)
+    if st != OK:
+        return st
+    st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
+    if st != OK:
+        return st
+    if not cholesky(M):
+        return NONFINITE_RESULT
+    for k in range(nv):
+        tmp[k] = tau[k] - h[k]
+    forward(M, tmp)
+    backward(M, tmp)
+    for k in range(nv):
+        vf[k] = v[k] + dt * tmp[k]
+    oR, op, oS = cws[1][2], cws[1][3], cws[2]
+    ns = surf.shape[0]
+    m = 0
+    for p in range(points.shape[0]):
+        b, rad = points[p], radii[p]
+        for r in range(3):
+            x[r] = op[b, r] + oR[b, r, 0] * centers[p, 0] + oR[b, r, 1] * centers[p, 1] + oR[b, r, 2] * centers[p, 2]
+        for s in range(ns):
+            pair = p * ns + s
+            phi = surf[s, 0] * x[0] + surf[s, 1] * x[1] + surf[s, 2] * x[2] - surf[s, 3] - rad
+            dist[pair] = phi
+            for r in range(3):
+                force[pair, r] = 0.0
+            F, rows = frames[m], Jc[3 * m:3 * m + 3]
+            contact_frame(surf[s], F)
+            for r in range(3):  # the sphere's point nearest the surface
+                tmp[r] = x[r] - rad * F[0, r]
+            point_rows(ints, oS, b, tmp[:3], F, rows)
+            u_free, u_before = _dot(rows[0], vf), _dot(rows[0], v)
+            if phi >= settings[MARGIN] - dt * min(u_free, 0.0):
+                for r in range(3):
+                    warm[pair, r] = 0.0
+                continue
+            if phi > 0.0:  # may close the gap, not cross it
+                target = -phi / dt
+            else:  # push out, at a bounded speed
+                target = min(settings[STABILIZATION] * -phi / dt, settings[MAX_CORRECTION])
+            if surf[s, 5] > 0.0 and u_before < -settings[BOUNCE_SPEED] and phi + dt * u_free < 0.0:
+                target = max(target, -surf[s, 5] * u_before)  # Newton's impact law
+            bias[m], mu[m], pair_of[m] = target, surf[s, 4], pair
+            for r in range(3):
+                P[3 * m + r] = warm[pair, r]
+            m += 1
+    info[ACTIVE] = m
+    for k in range(nv):
+        tmp[k] = 0.0
+    info[ITERATIONS], info[RESIDUAL] = 0.0, 0.0
+    if m > 0:
+        delassus(M, Jc, m, Y, G)
+        for r in range(3 * m):  # the free contact velocities minus their targets
+            u0[r] = _dot(Jc[r], vf)
+        for c in range(m):
+            u0[3 * c] -= bias[c]
+        solve(G, u0, mu, m, P, int(settings[MAX_ITERATIONS]), settings[TOLERANCE], info, sws)
+        for i in range(nv):
+            s_ = 0.0
+            for r in range(3 * m):
+                s_ += Y[i, r] * P[r]
+            tmp[i] = s_
+        backward(M, tmp)
+    for k in range(nv):
+        v1[k] = vf[k] + tmp[k]
+        a[k] = (v1[k] - v[k]) / dt
+    for c in range(m):
+        pair, F = pair_of[c], frames[c]
+        for r in range(3):
+            force[pair, r] = (F[0, r] * P[3 * c] + F[1, r] * P[3 * c + 1] + F[2, r] * P[3 * c + 2]) / dt
+            warm[pair, r] = P[3 * c + r]
+    chart_rate(ints, q, zero, v1, R, tmp)
+    for k in range(nv):
+        tmp[k] *= dt
+    chart_point(ints, q, tmp, q1)
+    if not (finite(v1) and finite(q1)):
+        return NONFINITE_RESULT
+    return OK
+
+
+@kernel
+def step_kernel(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+                tau, a, q1, v1, force, dist, warm, info, ws):
+    """Compiled :func:`step` for the Python-driven controllers."""
+    return step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+                tau, a, q1, v1, force, dist, warm, info, ws)
+
+
+@kernel
+def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii, surf,
+        settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
+    """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
+    ``simulate._run_compiled``), writing ``Q[1:], V[1:]`` and, for every sample but the last
+    unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
+    solver ``info``. Returns ``(status, sample)`` of the first failure (``(OK, -1)``)."""
+    nv = V.shape[1]
+    ws = workspace(ints.shape[0], nv, D.shape[1])
+    cws = (rnea_workspace(c[0].shape[0]), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv))
+    cmd = np.empty(nv)
+    qn, vn = np.empty(Q.shape[1]), np.empty(nv)
+    n = Q.shape[0] - 1
+    for s in range(n + 1 if final else n):
+        q, v = Q[s], V[s]
+        st = law_torque(law, c, gains, breaks, coefs, (s0 + s) * dt, q, v, tau_cmd, cws, cmd)
+        if st == OK:
+            st = step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, cmd, dt,
+                      T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], ws)
+        if st != OK:
+            return st, s
+        if s < n:
+            Q[s + 1, :] = qn
+            V[s + 1, :] = vn
+    return OK, -1
+
