@@ -7,8 +7,9 @@
     traj = rd.simulate(model, q0, v0, 3.0, 1e-3, controller=ctrl)
 """
 
-from .controllers import AdaptiveSlotineLi, ComputedTorque, Controller, PDGravity, PIDGravity, SlotineLi, TaskSpacePD
+from .controllers import (AdaptiveSlotineLi, ComputedTorque, Controller, JointPD, PDGravity, PIDGravity, SlotineLi,
+                          TaskSpacePD)
 from .references import PointToPoint, Sampled, cubic, quintic
 
 __all__ = ["Controller", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
-           "cubic", "quintic", "AdaptiveSlotineLi"]
+           "cubic", "quintic", "AdaptiveSlotineLi", "JointPD"]

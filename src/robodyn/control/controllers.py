@@ -16,6 +16,8 @@ TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``           ``q
 SlotineLi           ``M qdd_r + C qd_r + g (+ friction) - Kd s``             ``s^T M s / 2 + q~^T Lambda Kd q~``
 AdaptiveSlotineLi   ``Y(q, qd, qd_r, qdd_r) theta_hat - Kd s``,              ``s^T M s / 2 + q~^T Lambda Kd q~``
                     ``theta_hat' = -Gamma^-1 Y^T s``                         ``+ theta~^T Gamma theta~ / 2``
+JointPD             ``tau_ff + Kp e - Kd qd`` on the actuated joints of any  (none reported)
+                    robot (a floating base unactuated)
 =================== ======================================================== ===================================
 
 References: Spong, Hutchinson, Vidyasagar, *Robot Modeling and Control* (2006), chapter 8
@@ -28,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import joints as J
 from ..algorithms.status import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
@@ -141,6 +144,57 @@ class PDGravity(Controller):
     def lyapunov(self, t, q, v):
         e = self.q_d - q
         return 0.5 * np.einsum("...i,...ij,...j->...", v, crba(self.model, q), v) + 0.5 * np.sum(self.kp * e * e, -1)
+
+
+class JointPD(Controller):
+    """Joint-space PD about a fixed posture with a constant feed-forward, for any robot,
+    floating bases included: ``tau_j = tau_ff_j + Kp_j (q_d,j - q_j) - Kd_j v_j`` on every
+    actuated joint, and zero on the free joint of a floating base (unactuated: a legged
+    robot stands through its contacts). The standing and posture controller of legged
+    robots; no gravity compensation (on a floating base it needs the contact forces).
+
+    ``q_desired``: a configuration (nq,) or the actuated joints' positions (na,);
+    ``kp``, ``kd``: scalars or (na,); ``tau_ff``: None or (na,). Every joint other than a
+    root free joint must have one dof."""
+
+    def __init__(self, model, q_desired, kp, kd, tau_ff=None):
+        self.model = model
+        free = [i for i in range(model.nbodies) if model.joint_type[i] == J.FREE]
+        if any(model.parent[i] >= 0 for i in free) or any(J.NV[model.joint_type[i]] != 1 for i in
+                                                           range(model.nbodies) if model.joint_type[i] != J.FREE):
+            raise ValueError("JointPD: every joint but a root free joint must have one dof (revolute, prismatic, "
+                             "helical)")
+        base = {k for i in free for k in range(model.idx_v[i], model.idx_v[i] + 6)}
+        self.actuated = np.array([k for k in range(model.nv) if k not in base], dtype=np.int64)
+        na = self.actuated.shape[0]
+        dof_body = np.empty(model.nv, dtype=np.int64)
+        for i in range(model.nbodies):
+            dof_body[model.idx_v[i]:model.idx_v[i] + J.NV[model.joint_type[i]]] = i
+        self.q_index = np.array([model.idx_q[dof_body[k]] for k in self.actuated], dtype=np.int64)
+        qd = np.array(q_desired, dtype=float)
+        if qd.shape == (model.nq,):
+            qd = qd[self.q_index]
+        if qd.shape != (na,) or not np.all(np.isfinite(qd)):
+            raise ValueError(f"q_desired: expected ({model.nq},) or ({na},) finite numbers, got shape {qd.shape}")
+        self.q_d = qd
+        self.kp, self.kd = gain("kp", kp, na), gain("kd", kd, na)
+        ff = np.zeros(na) if tau_ff is None else np.array(tau_ff, dtype=float)
+        if ff.shape != (na,) or not np.all(np.isfinite(ff)):
+            raise ValueError(f"tau_ff: expected ({na},) finite numbers, got shape {ff.shape}")
+        self.tau_ff = ff
+        self._table = np.zeros((5, model.nv))
+        for row, x in enumerate((self.kp, self.kd, self.q_index, self.q_d, self.tau_ff)):
+            self._table[row, self.actuated] = x
+
+    def __call__(self, t, q, v):
+        tau = np.zeros(self.model.nv)
+        tau[self.actuated] = self.tau_ff + self.kp * (self.q_d - q[self.q_index]) - self.kd * v[self.actuated]
+        return tau
+
+    def kernel_law(self):
+        if type(self).__call__ is not JointPD.__call__:
+            return None
+        return laws.JOINT_PD, self._table, np.array([0.0, 1.0]), np.zeros((1, 1, self.model.nv))
 
 
 class PIDGravity(PDGravity):

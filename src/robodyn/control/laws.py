@@ -3,8 +3,10 @@ controller's ``kernel_law``) and at every integrator stage of the Python-driven 
 where a batch kernel's thread start-up would dominate.
 
 Law codes: ``CONSTANT`` (the command ``tau_cmd``; zero: the free robot), ``PD_GRAVITY``
-(``Kp (q_d - q) - Kd qd + g(q)``) and ``COMPUTED_TORQUE``
-(``rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))``), with the reference a piecewise
+(``Kp (q_d - q) - Kd qd + g(q)``), ``COMPUTED_TORQUE``
+(``rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))``) and ``JOINT_PD``
+(``tau_ff + Kp (q_d - q) - Kd v`` on the actuated joints of any robot, floating bases
+included), with the reference a piecewise
 polynomial (:func:`reference_at`). Reference: Siciliano et al., *Robotics: Modelling, Planning
 and Control* (2009), chapter 8.
 """
@@ -21,6 +23,7 @@ from ..algorithms.status import CHECKED, NO_WRENCH, OK
 CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
 PD_GRAVITY = 1       # Kp (q_d - q) - Kd qd + g(q)
 COMPUTED_TORQUE = 2  # rnea(q, qd, qdd_d + Kd (qd_d - qd) + Kp (q_d - q))
+JOINT_PD = 3         # tau_ff + Kp (q_d - q) - Kd v on the actuated dofs (JointPD; any base)
 
 
 @inline
@@ -63,6 +66,10 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
     if law == CONSTANT:
         for k in range(out.shape[0]):
             out[k] = tau_cmd[k]
+        return OK
+    if law == JOINT_PD:  # gains: Kp, Kd, the dof's index in q, q_d, tau_ff (zero gains: unactuated)
+        for k in range(out.shape[0]):
+            out[k] = gains[4, k] + gains[0, k] * (gains[3, k] - q[int(gains[2, k])]) - gains[1, k] * v[k]
         return OK
     ws, qd, vd, ad, acc, zero = cws
     reference_at(breaks, coefs, t, qd, vd, ad)
