@@ -9,7 +9,10 @@ MuJoCo on the same scenes.
 
 from __future__ import annotations
 
+import functools
+import sys
 import warnings
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -18,6 +21,8 @@ from scipy.spatial.transform import Rotation
 
 import robodyn as rd
 from robodyn import joints as J
+from robodyn import plots
+from robodyn.control import JointPD, laws
 from robodyn.algorithms.constrained import frame_kinematics
 from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere
 from robodyn.random import random_model, random_state
@@ -198,15 +203,21 @@ def test_python_and_compiled_steps_agree():
 # --- a quadruped standing -------------------------------------------------------------------
 
 SOLO_FEET = ("FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT")
+STANCE = np.array([0, 0.8, -1.6] * 2 + [0, -0.8, 1.6] * 2)
+
+
+@functools.cache
+def solo12():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)  # the URDF's <contact> elements
+        return rd.load_urdf(example_robot_data_dir() / "solo_description/robots/solo12.urdf", floating_base=True)
 
 
 def test_solo12_dropped_on_the_ground_stands_on_its_weight():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", rd.RobodynWarning)  # the URDF's <contact> elements
-        model = rd.load_urdf(example_robot_data_dir() / "solo_description/robots/solo12.urdf", floating_base=True)
+    model = solo12()
     mu = 0.9
     contacts = Contacts([Sphere(f, 0.0175) for f in SOLO_FEET], surfaces=[Plane(friction=mu)])
-    stance = np.array([0, 0.8, -1.6] * 2 + [0, -0.8, 1.6] * 2)
+    stance = STANCE
     q0 = np.concatenate([[0, 0, 0.5], [0, 0, 0, 1], stance])  # feet about 0.25 m above the floor
 
     def standing(t, q, v):  # joint PD about the stance, the base unactuated
@@ -224,6 +235,55 @@ def test_solo12_dropped_on_the_ground_stands_on_its_weight():
     feet = np.array([[rd.frame_pose(model, q, foot)[:3, 3] for foot in SOLO_FEET] for q in traj.q[rest]])
     assert np.abs(feet - feet[0]).max() < 1e-6  # no slip
     assert np.abs(feet[..., 2] - 0.0175).max() < 1e-6  # on the floor, not in it
+
+
+def test_solo12_example_stands():
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import solo12_standing as ex
+
+    model, traj = ex.run(example_robot_data_dir() / "solo_description/robots/solo12.urdf", duration=1.0)
+    assert traj.normal_force[-1].sum() == pytest.approx(model.total_mass * G, rel=1e-6)
+    assert np.all(traj.friction_force[-1] < 0.9 * traj.normal_force[-1])
+
+
+def test_joint_pd_is_compiled_and_leaves_a_floating_base_unactuated():
+    model = solo12()
+    q0 = np.concatenate([[0, 0, 0.5], [0, 0, 0, 1], STANCE])
+    ctrl = JointPD(model, q0, kp=8.0, kd=0.3, tau_ff=np.full(12, 0.1))
+    rng = np.random.default_rng(1)
+    q, v = rd.random.random_state(model, rng)[:2]
+    tau = ctrl(0.0, q, v)
+    np.testing.assert_array_equal(tau[:6], 0.0)
+    np.testing.assert_allclose(tau[6:], 0.1 + 8.0 * (STANCE - q[7:]) - 0.3 * v[6:], rtol=1e-12)
+    assert ctrl.kernel_law()[0] == laws.JOINT_PD
+    np.testing.assert_array_equal(JointPD(model, STANCE, 8.0, 0.3).q_d, STANCE)  # the joints alone
+    contacts = Contacts([Sphere(f, 0.0175) for f in SOLO_FEET])
+    compiled = rd.simulate(model, q0, np.zeros(model.nv), 0.5, 1e-3, ctrl, contacts=contacts)
+    python = rd.simulate(model, q0, np.zeros(model.nv), 0.5, 1e-3, lambda t, q, v: ctrl(t, q, v), contacts=contacts)
+    np.testing.assert_allclose(compiled.q, python.q, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(compiled.contact_force, python.contact_force, rtol=0, atol=1e-6)
+    np.testing.assert_array_equal(compiled.tau[:, :6], 0.0)
+    with pytest.raises(ValueError, match="q_desired: expected"):
+        JointPD(model, np.zeros(5), 1.0, 1.0)
+    with pytest.raises(ValueError, match="kp: gains must be finite and > 0"):
+        JointPD(model, STANCE, -1.0, 1.0)
+    with pytest.raises(ValueError, match="tau_ff: expected"):
+        JointPD(model, STANCE, 1.0, 1.0, tau_ff=np.zeros(3))
+    spherical = random_model(3, seed=0, joint_types=(J.SPHERICAL,))
+    with pytest.raises(ValueError, match="every joint but a root free joint must have one dof"):
+        JointPD(spherical, np.zeros(spherical.nq), 1.0, 1.0)
+
+
+def test_plot_contacts_draws_the_forces_and_the_cones_used(tmp_path):
+    traj, _ = incline(np.radians(35.0), 0.5, duration=0.2)
+    data = plots.plot_contacts(traj, tmp_path / "contacts.png")
+    assert (tmp_path / "contacts.png").stat().st_size > 0
+    assert data["names"] == traj.contact_names and len(data["names"]) == 8
+    np.testing.assert_allclose(np.nansum(data["normal"][-1]), BOX_M * G * np.cos(np.radians(35.0)), rtol=1e-7)
+    used = data["cone_usage"][-1]
+    np.testing.assert_allclose(used[np.isfinite(used)], 1.0, rtol=1e-9)  # sliding: on the cones
+    with pytest.raises(ValueError, match="has no contacts"):
+        plots.plot_contacts(rd.simulate(BOX, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.01, 1e-3))
 
 
 # --- MuJoCo on the same scenes ---------------------------------------------------------------

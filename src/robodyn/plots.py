@@ -157,6 +157,33 @@ def plot_simulation(traj, path=None) -> dict:
     return data
 
 
+def plot_contacts(traj, path=None) -> dict:
+    """The contact forces of a :class:`Trajectory` simulated with contacts: each pair's
+    normal force, its friction force, and the share of its friction cone used,
+    ``|f_t| / (mu f_n)`` (1: sliding or about to; pairs apart are left blank). Returns
+    ``{"t", "names", "normal", "friction", "cone_usage"}``."""
+    if traj.contact_force is None:
+        raise ValueError("plot_contacts: the trajectory has no contacts (simulate with contacts=...)")
+    normal, friction = traj.normal_force, traj.friction_force
+    with np.errstate(divide="ignore", invalid="ignore"):
+        usage = np.where(normal > 0, friction / (traj.contact_friction * normal), np.nan)
+    data = dict(t=traj.t, names=traj.contact_names, normal=normal, friction=friction, cone_usage=usage)
+    fig, axes = _figure(3)
+    for k, name in enumerate(traj.contact_names):
+        axes[0, 0].plot(traj.t, normal[:, k], label=name)
+        axes[1, 0].plot(traj.t, friction[:, k])
+        axes[2, 0].plot(traj.t, usage[:, k])
+    axes[0, 0].plot(traj.t, normal.sum(axis=1), "k--", label="sum")
+    axes[0, 0].legend(fontsize=7, ncol=2)
+    for ax, label in zip(axes[:, 0], ("normal force [N]", "friction force [N]", "|f_t| / (mu f_n)")):
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    axes[2, 0].set_ylim(0.0, 1.05)
+    axes[2, 0].set_xlabel("t [s]")
+    _save(fig, path)
+    return data
+
+
 def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     """World points (N, P, 3) of the stick figure and its segments ``(i, j)``.
 

@@ -280,9 +280,11 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
 
 
 class Touch(NamedTuple):
-    """The contact samples of a run: pair names, forces (N, npairs, 3), distances (N, npairs),
-    solver info (N, 3)."""
+    """The contact samples of a run: pair names, each pair's surface normal (npairs, 3) and
+    friction (npairs,), forces (N, npairs, 3), distances (N, npairs), solver info (N, 3)."""
     names: tuple
+    normal: np.ndarray
+    friction: np.ndarray
     force: np.ndarray
     distance: np.ndarray
     info: np.ndarray
@@ -296,7 +298,9 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
     (points, centers, radii), surf, settings, names = contacts.pack(model)
     N, nv, nz = Q.shape[0], model.nv, Z.shape[1]
     n = N - 1
-    touch = Touch(names, np.zeros((N, len(names), 3)), np.zeros((N, len(names))), np.zeros((N, CS.INFO_SIZE)))
+    pair_surface = surf[np.arange(len(names)) % surf.shape[0]]
+    touch = Touch(names, pair_surface[:, :3].copy(), pair_surface[:, 4].copy(), np.zeros((N, len(names), 3)),
+                  np.zeros((N, len(names))), np.zeros((N, CS.INFO_SIZE)))
     warm = np.zeros((len(names), 3))
     geometry = (points, centers, radii, surf, settings)
     Q[0], V[0] = q0, v0
@@ -446,6 +450,7 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
                       controller_state=Z if law.stateful else None, integrator=integrator,
                       **({} if touch is None else dict(
-                          contact_names=touch.names, contact_force=touch.force, contact_distance=touch.distance,
+                          contact_names=touch.names, contact_normal=touch.normal, contact_friction=touch.friction,
+                          contact_force=touch.force, contact_distance=touch.distance,
                           solver_iterations=touch.info[:, CS.ITERATIONS].astype(np.int64),
                           solver_residual=touch.info[:, CS.RESIDUAL])))

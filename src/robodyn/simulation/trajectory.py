@@ -25,7 +25,8 @@ class Trajectory:
     the controller's reference or None; ``controller_state`` (N, nz) the internal state of a
     controller that has one (see :func:`robodyn.simulate`), else None.
 
-    With contacts: ``contact_names`` the pairs ``"<shape>@<surface>"``; ``contact_force``
+    With contacts: ``contact_names`` the pairs ``"<shape>@<surface>"``, ``contact_normal``
+    (npairs, 3) and ``contact_friction`` (npairs,) their surface's normal and ``mu``; ``contact_force``
     (N, npairs, 3) the force each pair's surface applies to the robot (world axes, N; zero
     when apart), over the step that starts at the sample; ``contact_distance`` (N, npairs)
     the signed distance (m, negative: penetration); ``solver_iterations`` (N,) and
@@ -47,10 +48,25 @@ class Trajectory:
     controller_state: np.ndarray | None = None
     integrator: str = "rk4"
     contact_names: tuple | None = None
+    contact_normal: np.ndarray | None = None
+    contact_friction: np.ndarray | None = None
     contact_force: np.ndarray | None = None
     contact_distance: np.ndarray | None = None
     solver_iterations: np.ndarray | None = None
     solver_residual: np.ndarray | None = None
+
+    @property
+    def normal_force(self) -> np.ndarray | None:
+        """``(N, npairs)`` the normal component of each pair's contact force (N), or None."""
+        return None if self.contact_force is None else np.einsum("kpi,pi->kp", self.contact_force, self.contact_normal)
+
+    @property
+    def friction_force(self) -> np.ndarray | None:
+        """``(N, npairs)`` the magnitude of each pair's tangential (friction) force (N), or None."""
+        if self.contact_force is None:
+            return None
+        tangential = self.contact_force - self.normal_force[..., None] * self.contact_normal
+        return np.linalg.norm(tangential, axis=-1)
 
     @property
     def tracking_error(self) -> np.ndarray | None:
