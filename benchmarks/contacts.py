@@ -1,6 +1,6 @@
 """Contact simulation against MuJoCo: Solo12 on the ground at 1 kHz, one process.
 
-    python benchmarks/contacts.py [--seconds 2]
+    python benchmarks/contacts.py [--seconds 2] [--rollouts 1000]
 
 The same robot (the MJCF that ``rd.write_mjcf`` writes from example-robot-data's URDF, with a
 sphere of radius 0.0175 m at each foot and a floor, MuJoCo's elliptic cones and Euler
@@ -8,8 +8,10 @@ integrator), the same joint PD about a standing posture (MuJoCo: position actuat
 ``kp`` and ``kv``; robodyn: ``control.JointPD``, compiled), the same time step. Two phases:
 the drop from 0.25 m (feet above the floor) and standing after settling. robodyn: one
 ``rd.simulate`` call per phase; MuJoCo: ``mujoco.rollout`` (its C loop, no Python per step).
-Per-step times are the best of interleaved rounds. Ratio: robodyn / MuJoCo, below 1
-robodyn is faster.
+Per-step times are the best of interleaved rounds. Then batched rollouts: ``--rollouts`` drops of 1 s
+from random heights and yaw rates, ``rd.rollout`` (keeping the first and last samples) against
+``mujoco.rollout`` with one ``MjData`` per thread (which keeps every state), throughput in
+steps per second. Ratio: robodyn / MuJoCo time, below 1 robodyn is faster.
 
 The two contact models differ (robodyn: rigid contacts, exact Coulomb cones; MuJoCo: soft
 convex contacts), so the trajectories differ by the contact compliance; printed: the
@@ -26,6 +28,7 @@ import time
 import warnings
 from pathlib import Path
 
+import numba
 import numpy as np
 
 import robodyn as rd
@@ -71,6 +74,7 @@ def main() -> None:
 
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--seconds", type=float, default=2.0, help="simulated time per phase")
+    p.add_argument("--rollouts", type=int, default=1000, help="batched rollouts (drops)")
     args = p.parse_args()
     n = int(round(args.seconds / DT))
 
@@ -107,7 +111,32 @@ def main() -> None:
             best[1] = min(best[1], (time.perf_counter() - t0) / n)
         print(f"  {phase:<10} {best[0] * 1e6:16.2f} {best[1] * 1e6:15.2f} {best[0] / best[1]:7.3g}")
     z_mj = state[0, -1, 1 + 2]  # mjSTATE_FULLPHYSICS: time, then qpos
-    print(f"  settled base height: robodyn {traj.q[-1, 2]:.5f} m, MuJoCo {z_mj:.5f} m; robodyn's normal forces "
+    height = traj.q[-1, 2]
+
+    # Batched rollouts: drops from random heights and yaw rates, every state kept by neither
+    rng = np.random.default_rng(0)
+    B = args.rollouts
+    Q0 = np.tile(q0, (B, 1))
+    Q0[:, 2] += rng.uniform(-0.05, 0.05, B)
+    V0 = np.zeros((B, model.nv))
+    V0[:, 5] = rng.uniform(-1.0, 1.0, B)
+    S0 = np.stack([mj_state(q, v) for q, v in zip(Q0, V0)])
+    threads = numba.get_num_threads()
+    datas = [mujoco.MjData(mj) for _ in range(threads)]
+    best, m = [np.inf, np.inf], int(round(1.0 / DT))  # drops of 1 s
+    for _ in range(3):
+        t0 = time.perf_counter()
+        rd.rollout(model, Q0, V0, m * DT, DT, ctrl, contacts=contacts, every=m)
+        best[0] = min(best[0], time.perf_counter() - t0)
+        t0 = time.perf_counter()
+        for k in range(0, B, 100):  # in pieces: MuJoCo keeps every state (0.5 GB for all at once)
+            rollout.rollout(mj, datas, S0[k:k + 100], np.tile(STANCE, (min(100, B - k), m, 1)))
+        best[1] = min(best[1], time.perf_counter() - t0)
+    steps = B * m
+    print(f"\n{B} rollouts of {m} steps on {threads} threads (rd.rollout, mujoco.rollout with {threads} MjData)")
+    print(f"  {'':<10} {'robodyn steps/s':>16} {'MuJoCo steps/s':>15} {'ratio':>7}")
+    print(f"  {'rollouts':<10} {steps / best[0]:16.0f} {steps / best[1]:15.0f} {best[0] / best[1]:7.3g}")
+    print(f"  settled base height: robodyn {height:.5f} m, MuJoCo {z_mj:.5f} m; robodyn's normal forces "
           f"sum to {traj.contact_force[-1, :, 2].sum():.6f} N (weight {model.total_mass * 9.81:.6f} N)")
 
 

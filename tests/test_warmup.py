@@ -10,7 +10,7 @@ def test_every_public_algorithm_and_the_simulation_are_warmed_up():
     names = {name.split(" (")[0] for name, _ in W.steps()}
     functions = {n for n, module in rd._LAZY.items() if not inspect.isclass(getattr(rd, n))}
     assert functions - names == set()
-    assert "simulate" in names
+    assert {"simulate", "rollout"} <= names
 
 
 def test_progress_reports_each_step_then_the_end(monkeypatch):

@@ -33,7 +33,8 @@ _LAZY = {
     "aba_derivatives": "aba_derivatives",
 }
 # Applications, also imported on first use: name -> module.
-_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation", "simulation": None,
+_LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
+              "rollout": "simulation", "Rollouts": "simulation", "simulation": None,
               "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
               "contact": None, "Contacts": "contact"}
 
@@ -78,7 +79,7 @@ __all__ = [
     "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
     "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",
-    "contact", "Contacts",
+    "contact", "Contacts", "rollout", "Rollouts",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

@@ -84,7 +84,8 @@ def _simulation_steps(rd, model):
     touch = Contacts([Sphere(model.nbodies - 1, 0.05)], surfaces=[Plane(height=10.0)])  # in contact from the start
     return out + [(name, lambda c=c: rd.simulate(model, q0, v0, 0.004, 0.002, c, contacts=touch, progress=False))
                   for name, c in (("simulate (contacts)", None), ("simulate (contacts, Python controller)",
-                                                                   python_law))]
+                                                                   python_law))] + [
+        ("rollout (contacts)", lambda: rd.rollout(model, np.stack([q0, q0]), v0, 0.004, 0.002, pd, contacts=touch))]
 
 
 def _public():
@@ -95,14 +96,14 @@ def _public():
     from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives,
                              hybrid, integrate, jacobian, kinematics, minv, regressor, rnea, rnea_derivatives,
                              task_space, terms)
-    from .simulation import simulate
+    from .simulation import rollout, simulate
 
     names = {}
     for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives, hybrid,
                    integrate, jacobian, kinematics, minv, regressor, rnea, rnea_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module)
                       if not n.startswith("_") and not isinstance(getattr(module, n), ModuleType)})
-    return SimpleNamespace(**names, simulate=simulate, random=random)
+    return SimpleNamespace(**names, simulate=simulate, rollout=rollout, random=random)
 
 
 def steps():

@@ -9,5 +9,6 @@ from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, simulate
 from ..io.trajectory_csv import coordinate_names, read_csv
 from .trajectory import Trajectory
 from .linearize import linearize
+from .rollout import Rollouts, rollout
 
-__all__ = ["simulate", "linearize", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]
+__all__ = ["simulate", "rollout", "Rollouts", "linearize", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]

@@ -210,13 +210,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if cmodel is not None and (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
-    for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
-        k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
-        n = np.linalg.norm(q0[k:k + size])
-        if abs(n - 1.0) > J.QUAT_TOL:
-            unit = "quaternion" if size == 4 else "(cos, sin)"
-            raise ValueError(f"q0: {unit} q0[{k}:{k + size}] has norm {n:.6g}, not 1; normalise it")
-        q0[k:k + size] /= n
+    unit_configuration(model, q0)
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
     Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))
@@ -239,6 +233,20 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
         _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
     bar.close()
     return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch)
+
+
+def unit_configuration(model, q0: np.ndarray, name: str = "q0") -> None:
+    """Normalise in place the unit parts of ``q0`` (..., nq) (quaternions, a planar joint's
+    ``(cos, sin)``); an error names one that is farther than ``joints.QUAT_TOL`` from unit."""
+    for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
+        k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
+        n = np.linalg.norm(q0[..., k:k + size], axis=-1, keepdims=True)
+        if np.any(abs(n - 1.0) > J.QUAT_TOL):
+            unit = "quaternion" if size == 4 else "(cos, sin)"
+            bad = np.unravel_index(np.argmax(abs(n - 1.0)), n.shape)[:-1]
+            where = f"{name}[{', '.join(map(str, bad)) + ', ' if bad else ''}{k}:{k + size}]"
+            raise ValueError(f"{name}: {unit} {where} has norm {float(n[bad][0]):.6g}, not 1; normalise it")
+        q0[..., k:k + size] /= n
 
 
 def _kernel_law(controller):

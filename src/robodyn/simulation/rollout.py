@@ -1,0 +1,129 @@
+"""Batched rollouts: many simulations of one model from many initial states, in parallel.
+
+    R = rd.rollout(model, q0, v0, duration, dt, controller=None, contacts=None)
+
+``q0`` (B, nq) and ``v0`` (B, nv) (either may be one state, broadcast): ``B`` rollouts of the
+same robot, controller and contacts, each the time stepping of :func:`robodyn.simulate` with
+``integrator="semi_implicit_euler"`` (the contact solver's scheme, with or without contacts:
+a step solves ``M (v+ - v) = dt (tau - h) + J^T P``), run on all threads in compiled code (as
+MuJoCo's ``rollout``). Each rollout equals the single simulation from its initial state to
+the last bit. The controller must run in compiled code: None, ``control.PDGravity``,
+``ComputedTorque`` or ``JointPD``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..algorithms.driver import batch_kernel, chunks
+from ..algorithms.status import OK
+from ..contact import solver as CS
+from ..errors import RobodynWarning
+from . import _contact_step as CK
+from .simulate import _law_arrays, _kernel_law, _positive, _raise, unit_configuration
+
+_batch = batch_kernel(CK.rollout_at, CK.rollout_workspace)
+
+
+@dataclass(frozen=True)
+class Rollouts:
+    """``B`` rollouts sampled at ``t`` (N,): ``q`` (B, N, nq), ``v``, ``a``, ``tau`` (B, N, nv)
+    (as :class:`Trajectory`'s); with contacts ``contact_names``, ``contact_force``
+    (B, N, npairs, 3), ``contact_distance`` (B, N, npairs), ``solver_iterations`` and
+    ``solver_residual`` (B, N)."""
+
+    model: object = field(repr=False)
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    a: np.ndarray
+    tau: np.ndarray
+    contact_names: tuple = ()
+    contact_force: np.ndarray | None = None
+    contact_distance: np.ndarray | None = None
+    solver_iterations: np.ndarray | None = None
+    solver_residual: np.ndarray | None = None
+
+
+def _states(name, x, n):
+    try:
+        a = np.array(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected an array of numbers, got {type(x).__name__}") from None
+    if a.ndim not in (1, 2) or a.shape[-1] != n:
+        raise ValueError(f"{name}: expected shape (B, {n}) or ({n},), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: contains NaN or Inf")
+    return a.reshape(-1, n)
+
+
+def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, contacts=None, every: int = 1) -> Rollouts:
+    """``B`` simulations of ``duration`` seconds with steps of ``dt`` from the initial states
+    ``q0`` (B, nq) and ``v0`` (B, nv) (one of them may be a single state), in parallel (see
+    the module docstring), keeping every ``every``-th sample (times ``k every dt``; the steps'
+    accelerations, torques and contact forces at those samples), so that long batches fit in
+    memory. Raises for the first rollout that fails (naming it and the time); warns, as
+    :func:`robodyn.simulate`, when contact solves stopped above ``warn_above``."""
+    q0, v0 = _states("q0", q0, model.nq), _states("v0", v0, model.nv)
+    B = max(q0.shape[0], v0.shape[0])
+    if q0.shape[0] not in (1, B) or v0.shape[0] not in (1, B):
+        raise ValueError(f"q0, v0: {q0.shape[0]} and {v0.shape[0]} states do not broadcast")
+    duration, dt = _positive("duration", duration), _positive("dt", dt)
+    if dt > duration:
+        raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
+    compiled = (0, None, None, None, None) if controller is None else _kernel_law(controller)
+    if compiled is None:
+        raise ValueError(f"controller: rollout runs compiled control laws only (None, PDGravity, ComputedTorque, "
+                         f"JointPD), got {type(controller).__name__}; use rd.simulate for other controllers")
+    cmodel = getattr(controller, "model", model)
+    if (cmodel.nq, cmodel.nv) != (model.nq, model.nv):
+        raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
+                         f"nq={model.nq}, nv={model.nv}")
+    if contacts is not None:
+        from ..contact.geometry import Contacts
+
+        if not isinstance(contacts, Contacts):
+            raise ValueError(f"contacts: expected a robodyn.contact.Contacts or None, got {type(contacts).__name__}")
+        (points, centers, radii), surf, settings, names = contacts.pack(model)
+    else:
+        points, centers, radii = np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0)
+        surf, settings, names = np.zeros((0, 6)), np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0]), ()
+    n = max(1, int(round(duration / dt)))
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1 or n % every:
+        raise ValueError(f"every: expected an integer >= 1 dividing the {n} steps, got {every!r}")
+    N, npairs = n // every + 1, len(names)
+    Q, V = np.empty((B, N, model.nq)), np.empty((B, N, model.nv))
+    Q[:, 0] = q0
+    V[:, 0] = v0
+    unit_configuration(model, Q[:, 0])
+    A, T = np.zeros((B, N, model.nv)), np.zeros((B, N, model.nv))
+    Fc, D, info = np.zeros((B, N, npairs, 3)), np.zeros((B, N, npairs)), np.zeros((B, N, CS.INFO_SIZE))
+    failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
+    k = model.kernel
+    c, law, gains, breaks, coefs = _law_arrays(model, compiled)
+    args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench, np.ascontiguousarray(model.effort_limit),
+            *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
+            Q, V, A, T, Fc, D, info, failed)
+    _batch(args, (model.nbodies, model.nv, npairs, c[0].shape[0], model.nq, int(every)), status, chunks(B))
+    bad = np.flatnonzero(status != OK)
+    if bad.size:
+        b = int(bad[0])
+        s, k = int(failed[b]), int(failed[b]) // every
+        try:
+            _raise(model, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
+        except ValueError as e:
+            raise ValueError(f"rollout {b}: {e}") from None
+    t = np.arange(0, n + 1, every) * dt
+    if contacts is None:
+        return Rollouts(model, t, Q, V, A, T)
+    residual = info[..., CS.RESIDUAL]
+    worst = np.unravel_index(np.argmax(residual), residual.shape)
+    if residual[worst] > contacts.warn_above:
+        warnings.warn(f"rollout: the contact solver stopped above {contacts.warn_above:g} m/s in "
+                      f"{int((residual > contacts.warn_above).sum())} of {residual.size} steps (largest residual "
+                      f"{residual[worst]:.3g} m/s in rollout {worst[0]} at t = {t[worst[1]]:.6g})",
+                      RobodynWarning, stacklevel=2)
+    return Rollouts(model, t, Q, V, A, T, names, Fc, D, info[..., CS.ITERATIONS].astype(np.int64), residual)

@@ -1,0 +1,106 @@
+"""Batched rollouts (rd.rollout): each rollout equals the single simulation from its initial
+state, to the last bit with contacts (the same compiled step), with or without a compiled
+controller; subsampling keeps exactly the samples it names; bad input is refused and a
+failing rollout is named."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn.contact import Box, Contacts, Plane
+from robodyn.control import JointPD, PDGravity
+from robodyn.random import random_model, random_state
+
+from test_contact import BOX, SIZE, SOLO_FEET, STANCE, solo12
+
+
+def box_states(B, seed=0):
+    rng = np.random.default_rng(seed)
+    q0 = np.zeros((B, 7))
+    q0[:, 2] = rng.uniform(0.1, 0.3, B)
+    quat = rng.standard_normal((B, 4))
+    q0[:, 3:] = quat / np.linalg.norm(quat, axis=1, keepdims=True)
+    return q0, rng.standard_normal((B, 6))
+
+
+BOX_CONTACTS = Contacts([Box("body", SIZE)], surfaces=[Plane(normal=(0.1, 0.0, 1.0), friction=0.4, restitution=0.3)])
+
+
+def test_each_rollout_is_the_simulation_from_its_state():
+    q0, v0 = box_states(5)
+    R = rd.rollout(BOX, q0, v0, 0.4, 1e-3, contacts=BOX_CONTACTS)
+    assert R.q.shape == (5, 401, 7) and R.contact_force.shape == (5, 401, 8, 3) and R.t[-1] == pytest.approx(0.4)
+    assert R.contact_names == BOX_CONTACTS.pack(BOX)[3]
+    for b in range(5):
+        traj = rd.simulate(BOX, q0[b], v0[b], 0.4, 1e-3, contacts=BOX_CONTACTS)
+        for key in ("q", "v", "a", "tau", "contact_force", "contact_distance", "solver_residual", "solver_iterations"):
+            np.testing.assert_array_equal(getattr(R, key)[b], getattr(traj, key), err_msg=key)
+    assert np.count_nonzero(R.contact_force[..., 2]) > 100
+
+
+def test_every_keeps_the_named_samples():
+    q0, v0 = box_states(3, seed=1)
+    full = rd.rollout(BOX, q0, v0, 0.3, 1e-3, contacts=BOX_CONTACTS)
+    some = rd.rollout(BOX, q0, v0, 0.3, 1e-3, contacts=BOX_CONTACTS, every=50)
+    np.testing.assert_array_equal(some.t, full.t[::50])
+    for key in ("q", "v", "a", "tau", "contact_force", "contact_distance", "solver_residual"):
+        np.testing.assert_array_equal(getattr(some, key), getattr(full, key)[:, ::50], err_msg=key)
+
+
+def test_a_quadruped_under_joint_pd_from_several_heights():
+    model = solo12()
+    q0 = np.concatenate([[0, 0, 0.45], [0, 0, 0, 1], STANCE])
+    Q0 = np.tile(q0, (3, 1))
+    Q0[:, 2] += [0.0, 0.03, 0.06]
+    ctrl = JointPD(model, q0, 8.0, 0.3)
+    contacts = Contacts([rd.contact.Sphere(f, 0.0175) for f in SOLO_FEET])
+    R = rd.rollout(model, Q0, np.zeros(model.nv), 1.0, 1e-3, ctrl, contacts=contacts, every=100)
+    traj = rd.simulate(model, Q0[2], np.zeros(model.nv), 1.0, 1e-3, ctrl, contacts=contacts)
+    np.testing.assert_array_equal(R.q[2], traj.q[::100])
+    np.testing.assert_allclose(R.contact_force[:, -1, :, 2].sum(axis=1), model.total_mass * 9.81, rtol=1e-6)
+
+
+def test_without_contacts_the_step_is_semi_implicit_euler():
+    model = random_model(5, seed=4)
+    rng = np.random.default_rng(4)
+    q0 = np.stack([random_state(model, rng)[0] for _ in range(3)])
+    ctrl = PDGravity(model, q0[0], kp=20.0, kd=3.0)
+    R = rd.rollout(model, q0, np.zeros(model.nv), 0.2, 1e-3, ctrl)
+    assert R.contact_force is None and R.contact_names == ()
+    for b in range(3):
+        traj = rd.simulate(model, q0[b], np.zeros(model.nv), 0.2, 1e-3, ctrl, "semi_implicit_euler")
+        np.testing.assert_allclose(R.q[b], traj.q, rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose(R.tau[b], traj.tau, rtol=1e-7, atol=1e-7)
+
+
+def test_one_state_broadcasts():
+    q0, v0 = box_states(4, seed=2)
+    R = rd.rollout(BOX, q0[0], v0, 0.05, 1e-3, contacts=BOX_CONTACTS)
+    assert R.q.shape[0] == 4
+    np.testing.assert_array_equal(R.q[:, 0], np.broadcast_to(q0[0], (4, 7)))
+
+
+def test_bad_input_is_refused_and_a_failing_rollout_named():
+    q0, v0 = box_states(2)
+    with pytest.raises(ValueError, match="controller: rollout runs compiled control laws only"):
+        rd.rollout(BOX, q0, v0, 0.1, 1e-3, lambda t, q, v: np.zeros(6))
+    with pytest.raises(ValueError, match="every: expected an integer >= 1 dividing the 100 steps"):
+        rd.rollout(BOX, q0, v0, 0.1, 1e-3, every=3)
+    with pytest.raises(ValueError, match=r"q0: expected shape \(B, 7\)"):
+        rd.rollout(BOX, np.zeros((2, 6)), v0, 0.1, 1e-3)
+    with pytest.raises(ValueError, match="do not broadcast"):
+        rd.rollout(BOX, q0, np.zeros((3, 6)), 0.1, 1e-3)
+    with pytest.raises(ValueError, match="v0: contains NaN"):
+        rd.rollout(BOX, q0, np.full(6, np.nan), 0.1, 1e-3)
+    bad = q0.copy()
+    bad[1, 3:] *= 2.0
+    with pytest.raises(ValueError, match=r"q0: quaternion q0\[1, 3:7\] has norm 2, not 1"):
+        rd.rollout(BOX, bad, v0, 0.1, 1e-3)
+    with pytest.raises(ValueError, match="contacts: expected a robodyn.contact.Contacts"):
+        rd.rollout(BOX, q0, v0, 0.1, 1e-3, contacts=Plane())
+    fast = v0.copy()
+    fast[1, 3:] = 1e200  # only rollout 1 spins so fast that its gyroscopic torque overflows
+    with pytest.raises(ValueError, match=r"rollout 1: simulate at t = 0: the result is not finite"):
+        rd.rollout(BOX, q0, fast, 0.1, 1e-3, contacts=BOX_CONTACTS)
