@@ -64,3 +64,37 @@ def test_errors(tmp_path, capsys):
     (tmp_path / "bad.csv").write_text("t,q:joint1\n0,1\n1,2\n")
     assert main(["torques", "planar_2r", str(tmp_path / "bad.csv")]) == 2
     assert "missing columns" in capsys.readouterr().err
+
+
+def test_simulate_a_quadruped_dropped_on_the_ground(tmp_path, capsys):
+    from conftest import example_robot_data_dir
+
+    urdf = str(example_robot_data_dir() / "solo_description/robots/solo12.urdf")
+    png = tmp_path / "contacts.png"
+    with pytest.warns(rd.RobodynWarning, match="<contact>"):
+        assert main(["simulate", urdf, "--ground", "--duration", "2", "--contact-plot", str(png)]) == 0
+    out = capsys.readouterr().out
+    assert "controller stand" in out and "semi_implicit_euler" in out
+    assert "4 spheres of 0.02 m on the ground (FL_FOOT, FR_FOOT, HL_FOOT, HR_FOOT); at the end 4 touch" in out
+    with pytest.warns(rd.RobodynWarning, match="<contact>"):
+        model = rd.load_urdf(urdf, floating_base=True)
+    weight = float(out.split("normal forces sum to ")[1].split(" N")[0])
+    assert weight == pytest.approx(model.total_mass * 9.81, rel=1e-4)
+    assert png.stat().st_size > 0
+
+
+def test_ground_options_and_their_errors(capsys):
+    # a fixed-base arm whose hand touches the floor: the contacts given by name
+    assert main(["simulate", "panda", "--ground", "--contacts", "link7", "--duration", "0.3", "--controller",
+                 "none", "--friction", "0.5"]) == 0
+    assert "1 spheres of 0.02 m on the ground (link7)" in capsys.readouterr().out
+    assert main(["simulate", "panda", "--contact-plot", "x.png"]) == 2
+    assert "--contact-plot applies to --ground" in capsys.readouterr().err
+    assert main(["simulate", "panda", "--ground", "--contacts", "nowhere"]) == 2
+    assert "--ground: Contacts.shapes[0]: unknown link or frame 'nowhere'" in capsys.readouterr().err
+    assert main(["simulate", "panda", "--ground", "--friction", "-1"]) == 2
+    assert "--ground: Plane.friction: must be >= 0" in capsys.readouterr().err
+    assert main(["simulate", "panda", "--ground", "--contact-radius", "0"]) == 2
+    assert "--ground: Sphere.radius: must be > 0" in capsys.readouterr().err
+    assert main(["simulate", "panda", "--ground", "--integrator", "rk4"]) == 2
+    assert "with contacts the time stepping is 'semi_implicit_euler'" in capsys.readouterr().err
