@@ -111,7 +111,8 @@ def main() -> None:
             best[1] = min(best[1], (time.perf_counter() - t0) / n)
         print(f"  {phase:<10} {best[0] * 1e6:16.2f} {best[1] * 1e6:15.2f} {best[0] / best[1]:7.3g}")
     z_mj = state[0, -1, 1 + 2]  # mjSTATE_FULLPHYSICS: time, then qpos
-    height = traj.q[-1, 2]
+    print(f"  settled base height: robodyn {traj.q[-1, 2]:.5f} m, MuJoCo {z_mj:.5f} m; robodyn's normal forces "
+          f"sum to {traj.contact_force[-1, :, 2].sum():.6f} N (weight {model.total_mass * 9.81:.6f} N)")
 
     # Batched rollouts: drops from random heights and yaw rates, every state kept by neither
     rng = np.random.default_rng(0)
@@ -136,8 +137,7 @@ def main() -> None:
     print(f"\n{B} rollouts of {m} steps on {threads} threads (rd.rollout, mujoco.rollout with {threads} MjData)")
     print(f"  {'':<10} {'robodyn steps/s':>16} {'MuJoCo steps/s':>15} {'ratio':>7}")
     print(f"  {'rollouts':<10} {steps / best[0]:16.0f} {steps / best[1]:15.0f} {best[0] / best[1]:7.3g}")
-    print(f"  settled base height: robodyn {height:.5f} m, MuJoCo {z_mj:.5f} m; robodyn's normal forces "
-          f"sum to {traj.contact_force[-1, :, 2].sum():.6f} N (weight {model.total_mass * 9.81:.6f} N)")
+
 
 
 if __name__ == "__main__":
