@@ -96,6 +96,45 @@ def test_inelastic_ball_comes_to_rest_on_its_weight():
     assert abs(traj.q[-1, 2] - BALL_R) < 1e-9 and np.abs(traj.v[-1]).max() < 1e-9
 
 
+def world_velocity(traj):
+    """The ball's centre velocity and angular velocity in world axes (the state's are in the body frame)."""
+    R = Rotation.from_quat(traj.q[:, 3:7]).as_matrix()
+    return np.einsum("kij,kj->ki", R, traj.v[:, :3]), np.einsum("kij,kj->ki", R, traj.v[:, 3:])
+
+
+def mujoco_ball(mu, v0, duration, dt=1e-3):
+    xml = f"""<mujoco><option timestep="{dt}" cone="elliptic" integrator="Euler"/>
+      <worldbody><geom type="plane" size="5 5 .1" friction="{mu} 0 0"/>
+        <body pos="0 0 {BALL_R}"><freejoint/><geom type="sphere" size="{BALL_R}" mass="{BALL_M}"
+          friction="{mu} 0 0"/></body></worldbody></mujoco>"""
+    m = mujoco.MjModel.from_xml_string(xml)
+    d = mujoco.MjData(m)
+    d.qvel[0] = v0
+    for _ in range(int(round(duration / dt))):
+        mujoco.mj_step(m, d)
+    return d.qvel.copy()
+
+
+def test_a_ball_thrown_sliding_rolls_at_five_sevenths_of_its_speed():
+    """Sliding, friction mu m g slows the centre and spins the ball up until it rolls, at
+    t = 2 v0 / (7 mu g), with v = 5 v0 / 7 and w = v / r (a solid sphere, I = 2 m r^2 / 5);
+    then it rolls for ever (no rolling resistance) without gaining energy. MuJoCo agrees."""
+    mu, v0 = 0.3, 2.0
+    q0 = np.array([0.0, 0.0, BALL_R, 0, 0, 0, 1])
+    contacts = Contacts([Sphere("body", BALL_R)], surfaces=[Plane(friction=mu)])
+    traj = rd.simulate(BALL, q0, np.array([v0, 0, 0, 0, 0, 0]), 1.5, 1e-3, contacts=contacts)
+    v, w = world_velocity(traj)
+    t_roll = 2 * v0 / (7 * mu * G)
+    rolling = traj.t > t_roll + 2e-3
+    np.testing.assert_allclose(v[rolling], np.broadcast_to([5 * v0 / 7, 0, 0], v[rolling].shape), atol=1e-6)
+    np.testing.assert_allclose(w[rolling, 1], 5 * v0 / 7 / BALL_R, rtol=1e-6)
+    sliding = traj.t < t_roll - 2e-3
+    np.testing.assert_allclose(traj.contact_force[sliding, 0], np.broadcast_to([-mu * BALL_M * G, 0, BALL_M * G],
+                                                                               (sliding.sum(), 3)), rtol=1e-6)
+    assert np.abs(traj.energy[rolling] - traj.energy[rolling][0]).max() < 1e-6
+    np.testing.assert_allclose(mujoco_ball(mu, v0, 1.5)[[0, 4]], [5 * v0 / 7, 5 * v0 / 7 / BALL_R], rtol=2e-3)
+
+
 def test_box_on_an_incline_sticks_below_atan_mu_and_slides_above():
     mu = 0.5
     for deg in (10.0, 20.0, 25.0):

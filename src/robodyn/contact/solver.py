@@ -20,17 +20,18 @@ with, for every contact, in its frame (normal ``n`` out of the surface, tangents
   (``u_t+ = 0``) inside the cone, sliding against the motion (``P_t = -mu P_n u_t+/|u_t+|``)
   on its boundary (maximal dissipation).
 
-Then ``q+ = q ⊞ dt v+`` (semi-implicit Euler on the configuration manifold).
+Then ``q+ = q ⊞ dt v+`` (semi-implicit Euler on the configuration manifold), the free and
+planar joints' linear velocities (coordinates in the turning child frame) stepped by their
+classical acceleration and turned into the next frame, so that a rolling or spinning body
+keeps its speed (``simulation._contact_step.moving_frame_terms``).
 
-Solver: projected Gauss-Seidel on the Delassus matrix (Moreau's NSGS; Jean 1999; Acary &
-Brogliato, *Numerical Methods for Nonsmooth Dynamical Systems*, 2008, ch. 12), one contact
-at a time: the normal impulse ``P_n <- max(0, P_n - (u_n - b_n) / G_nn)``, then the
-tangential impulse projected on the disc of radius ``mu P_n``:
-``P_t <- proj(P_t - u_t / g_t)``, with ``g_t`` the largest eigenvalue of the contact's 2 x 2
-tangential block (one step length for both directions, so that a fixed point is exactly
-Coulomb's law). It is warm-started from the previous step's impulses. A sweep's residual is
-its largest velocity correction ``G_nn |dP_n|``, ``g_t |dP_t|`` (m/s); the solve stops when a
-sweep's residual is below ``tolerance`` and reports whether it did.
+Solver (:func:`solve`): ADMM on the cone complementarity problem with De Saxce's correction
+``sigma = u + (mu |u_t|, 0, 0)`` (Carpentier et al., "From compliant to rigid contact
+simulation: a unified and efficient approach", RSS 2024; Pinocchio's ``ADMMContactSolver``),
+whose fixed points are exactly Coulomb's law, warm-started from the previous step's impulses;
+when redundant contacts (four corners of a face) make it crawl, an active-set polish
+(:func:`polish`). The residual (:func:`coulomb_residual`) is the largest velocity error of
+Coulomb's law in m/s.
 
 ``G`` is formed from the Cholesky factor of ``M = L L^T``: ``Y = L^-1 J^T``, ``G = Y^T Y``,
 and ``M^-1 J^T P = L^-T (Y P)``.

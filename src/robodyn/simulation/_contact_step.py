@@ -23,6 +23,8 @@ from ..contact.solver import (ACTIVE, BOUNCE_SPEED, INFO_SIZE, ITERATIONS, MARGI
                               STABILIZATION, TOLERANCE, backward, cholesky, contact_frame, delassus, forward, solve,
                               point_rows)
 from ..control.laws import law_torque
+from ..joints import FREE, PLANAR
+from ..layout import IV, JTYPE
 from ._kernels import chart_point, chart_rate
 
 
@@ -35,6 +37,54 @@ def workspace(nb, nv, npairs):
             np.empty(npairs), np.empty(npairs), np.empty(m3), np.empty((npairs, 3, 3)),
             np.empty(npairs, np.int64), np.empty((3, 3)), np.empty(nv), np.empty(3),
             (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))))
+
+
+@inline
+def moving_frame_terms(ints, v, h, out):
+    """``out += h w x v_lin`` for the free joints (``v = [v_lin; w]`` in the child frame) and
+    ``out[vx, vy] += h wz x (vx, vy)`` for the planar joints.
+
+    Their linear velocities are coordinates in a frame that turns with the body, so that
+    ``d v_lin / dt = a_lin = a_classical - w x v_lin`` (the spatial acceleration). Stepping
+    that rotation explicitly, ``v_lin + dt a_lin``, lengthens ``v_lin`` by ``sqrt(1 + (|w| dt)^2)``
+    each step (a rolling ball speeds up). The step instead moves the classical acceleration
+    (``h = dt``: ``v_f`` gains ``dt w x v_lin``), then turns the result into the next frame
+    (:func:`to_next_frame`): the velocity of the body's origin changes only by the forces."""
+    for i in range(ints.shape[0]):
+        jt, iv = ints[i, JTYPE], ints[i, IV]
+        if jt == FREE:
+            vx, vy, vz, wx, wy, wz = v[iv], v[iv + 1], v[iv + 2], v[iv + 3], v[iv + 4], v[iv + 5]
+            out[iv] += h * (wy * vz - wz * vy)
+            out[iv + 1] += h * (wz * vx - wx * vz)
+            out[iv + 2] += h * (wx * vy - wy * vx)
+        elif jt == PLANAR:
+            vx, vy, wz = v[iv], v[iv + 1], v[iv + 2]
+            out[iv] -= h * wz * vy
+            out[iv + 1] += h * wz * vx
+
+
+@inline
+def to_next_frame(ints, v1, dt):
+    """The free and planar joints' linear velocities ``v1`` (coordinates in the child frame at
+    the start of the step) in the child frame at its end, turned by ``exp(-dt w)`` (Rodrigues)."""
+    for i in range(ints.shape[0]):
+        jt, iv = ints[i, JTYPE], ints[i, IV]
+        if jt == FREE:
+            wx, wy, wz = -dt * v1[iv + 3], -dt * v1[iv + 4], -dt * v1[iv + 5]
+            t = np.sqrt(wx * wx + wy * wy + wz * wz)
+            if t == 0.0:
+                continue
+            ux, uy, uz = wx / t, wy / t, wz / t
+            c, s = np.cos(t), np.sin(t)
+            x, y, z = v1[iv], v1[iv + 1], v1[iv + 2]
+            d = (ux * x + uy * y + uz * z) * (1.0 - c)
+            v1[iv] = x * c + (uy * z - uz * y) * s + ux * d
+            v1[iv + 1] = y * c + (uz * x - ux * z) * s + uy * d
+            v1[iv + 2] = z * c + (ux * y - uy * x) * s + uz * d
+        elif jt == PLANAR:
+            s, c = np.sin(-dt * v1[iv + 2]), np.cos(-dt * v1[iv + 2])
+            x, y = v1[iv], v1[iv + 1]
+            v1[iv], v1[iv + 1] = c * x - s * y, s * x + c * y
 
 
 @inline
@@ -71,6 +121,7 @@ def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, se
     backward(M, tmp)
     for k in range(nv):
         vf[k] = v[k] + dt * tmp[k]
+    moving_frame_terms(ints, v, dt, vf)
     oR, op, oS = cws[1][2], cws[1][3], cws[2]
     ns = surf.shape[0]
     m = 0
@@ -124,6 +175,7 @@ def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, se
     for k in range(nv):
         v1[k] = vf[k] + tmp[k]
         a[k] = (v1[k] - v[k]) / dt
+    moving_frame_terms(ints, v, -1.0, a)  # the spatial acceleration M^-1 (tau - h + J^T lambda)
     for c in range(m):
         pair, F = pair_of[c], frames[c]
         for r in range(3):
@@ -133,6 +185,7 @@ def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, se
     for k in range(nv):
         tmp[k] *= dt
     chart_point(ints, q, tmp, q1)
+    to_next_frame(ints, v1, dt)
     if not (finite(v1) and finite(q1)):
         return NONFINITE_RESULT
     return OK

@@ -4,9 +4,10 @@
 
 ``q0`` (B, nq) and ``v0`` (B, nv) (either may be one state, broadcast): ``B`` rollouts of the
 same robot, controller and contacts, each the time stepping of :func:`robodyn.simulate` with
-``integrator="semi_implicit_euler"`` (the contact solver's scheme, with or without contacts:
-a step solves ``M (v+ - v) = dt (tau - h) + J^T P``), run on all threads in compiled code (as
-MuJoCo's ``rollout``). Each rollout equals the single simulation from its initial state to
+contacts (with or without them: a step solves ``M (v+ - v) = dt (tau - h) + J^T P``, the
+free and planar joints' linear velocities stepped in a frame that does not turn with the body,
+see ``_contact_step.moving_frame_terms``; for other joints it is ``simulate``'s
+semi-implicit Euler), run on all threads in compiled code (as MuJoCo's ``rollout``). Each rollout equals the single simulation from its initial state to
 the last bit. The controller must run in compiled code: None, ``control.PDGravity``,
 ``ComputedTorque`` or ``JointPD``.
 """
