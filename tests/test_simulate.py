@@ -271,3 +271,112 @@ def test_bad_input():
     q0[3:7] *= 1.5
     with pytest.raises(ValueError, match=r"q0: quaternion q0\[3:7\] has norm 1.5"):
         rd.simulate(floating, q0, v0, 0.1, 1e-3)
+
+
+# --- external wrenches and bilateral constraints ---------------------------------------------
+
+def free_body(mass=2.0, gravity=(0.0, 0.0, 0.0)):
+    b = rd.ModelBuilder(gravity=gravity)
+    b.add_link("body", mass=mass, inertia=np.diag([0.01, 0.02, 0.03]))
+    return b.build(floating_base=True)
+
+
+def test_a_constant_force_accelerates_a_free_body_uniformly():
+    body = free_body()
+    F = np.zeros((1, 6))
+    F[0, :3] = [2.0, -1.0, 0.5]
+    v0 = np.array([0, 0, 0, 0.3, -0.2, 0.5])  # spinning: the world force must not turn with it
+    for frame, integrator in (("world", "rk4"), ("local_world_aligned", "semi_implicit_euler")):
+        traj = rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], v0, 1.0, 1e-3, None, integrator, f_ext=F, f_ext_frame=frame)
+        np.testing.assert_allclose(traj.q[-1, :3], F[0, :3] / 2.0 / 2.0, rtol=2e-3 if integrator != "rk4" else 1e-9)
+        # the compiled run (constant array) equals the Python-driven one (callable)
+        again = rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], v0, 1.0, 1e-3, None, integrator, f_ext=lambda t, q, v: F,
+                            f_ext_frame=frame)
+        np.testing.assert_allclose(again.q, traj.q, rtol=0, atol=1e-12)
+
+
+def test_a_spring_to_the_world_makes_a_harmonic_oscillator():
+    body, k = free_body(mass=2.0), 50.0
+
+    def spring(t, q, v):
+        f = np.zeros((1, 6))
+        f[0, :3] = -k * q[:3]  # world force at the body origin
+        return f
+
+    traj = rd.simulate(body, [0.1, 0, 0, 0, 0, 0, 1], np.zeros(6), 2.0, 1e-3, f_ext=spring,
+                       f_ext_frame="local_world_aligned")
+    np.testing.assert_allclose(traj.q[:, 0], 0.1 * np.cos(np.sqrt(k / 2.0) * traj.t), rtol=0, atol=1e-9)
+
+
+def test_simulated_accelerations_satisfy_the_inverse_dynamics_with_wrenches():
+    model = random_model(5, seed=11, floating_base=True)
+    rng = np.random.default_rng(11)
+    q0, v0 = random_state(model, rng)[:2]
+    F = rng.standard_normal((model.nbodies, 6))
+    traj = rd.simulate(model, q0, v0, 0.05, 1e-3, f_ext=F, f_ext_frame="world")
+    for s in (0, 20, 50):
+        np.testing.assert_allclose(rd.rnea(model, traj.q[s], traj.v[s], traj.a[s], F, "world"), traj.tau[s],
+                                   atol=1e-8 * (1 + np.abs(traj.a[s]).max()))
+
+
+def test_a_four_bar_linkage_stays_closed_under_simulate():
+    from test_constrained import _closed_configuration, _four_bar
+    from robodyn.algorithms.constrained import constraint_jacobian
+
+    model, loop = _four_bar()
+    q0 = _closed_configuration(1.0)
+    J = constraint_jacobian(model, q0, np.zeros(3), [loop])[0][0]
+    v0 = 2.0 * np.linalg.svd(J)[2][-1]
+    traj = rd.simulate(model, q0, v0, 3.0, 1e-3, constraints=[loop])
+    assert traj.constraint_force.shape == (3001, 3) and np.ptp(traj.q[:, 0]) > 1.0
+    phi = np.array([constraint_jacobian(model, q, v, [loop])[2][0] for q, v in zip(traj.q[::50], traj.v[::50])])
+    assert np.abs(phi).max() < 1e-6
+    assert np.ptp(traj.energy) < 1e-5 * abs(traj.energy[0])
+    # pushed at the coupler: the inverse dynamics with the wrench balance the loop's force
+    F = np.zeros((model.nbodies, 6))
+    F[model.link_names.index("coupler"), :3] = [0.0, 5.0, 0.0]
+    traj = rd.simulate(model, q0, v0, 0.5, 1e-3, f_ext=F, f_ext_frame="local_world_aligned", constraints=[loop],
+                       baumgarte=(20.0, 20.0))
+    for s in (0, 250, 500):
+        q, v = traj.q[s], traj.v[s]
+        Jc = constraint_jacobian(model, q, v, [loop])[0][0]
+        lhs = rd.rnea(model, q, v, traj.a[s], F, "local_world_aligned") - traj.tau[s]
+        np.testing.assert_allclose(lhs, Jc.T @ traj.constraint_force[s], atol=1e-9)
+
+
+def test_contacts_with_an_external_push():
+    """A box on the ground pushed by a horizontal force F: it stays when F < mu m g, else it
+    slides with (F - mu m g) / m."""
+    from robodyn.contact import Box, Contacts, Plane
+
+    b = rd.ModelBuilder()
+    b.add_link("box", mass=1.0, inertia=np.diag([0.002, 0.002, 0.003]))
+    box = b.build(floating_base=True)
+    contacts = Contacts([Box("box", (0.1, 0.1, 0.05))], surfaces=[Plane(friction=0.5)])
+    q0 = [0, 0, 0.025, 0, 0, 0, 1]
+    for push, accel in ((4.0, 0.0), (7.0, 7.0 - 0.5 * G)):
+        F = np.zeros((1, 6))
+        F[0, 0] = push
+        traj = rd.simulate(box, q0, np.zeros(6), 0.5, 1e-3, f_ext=F, f_ext_frame="local_world_aligned",
+                           contacts=contacts)
+        x = traj.q[:, 0]
+        assert x[-1] == pytest.approx(0.5 * accel * 0.5 * 0.501, abs=1e-6)  # semi-implicit Euler: t (t + dt) / 2
+
+
+def test_bad_wrenches_and_constraints_are_refused():
+    body = free_body()
+    with pytest.raises(ValueError, match=r"f_ext: expected shape \(\.\.\., 1, 6\)"):
+        rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3, f_ext=np.zeros(6))
+    with pytest.raises(ValueError, match="f_ext_frame must be one of"):
+        rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3, f_ext=np.zeros((1, 6)), f_ext_frame="base")
+    with pytest.raises(ValueError, match=r"f_ext at t = 0.05: f_ext: contains NaN"):
+        rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3,
+                    f_ext=lambda t, q, v: np.full((1, 6), np.nan if t > 0.0499 else 0.0))
+    from robodyn.contact import Contacts, Sphere
+
+    pin = rd.PointConstraint("body", (0, 0, 0), (0, 0, 0))
+    with pytest.raises(ValueError, match="constraints: not with contacts"):
+        rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3, constraints=[pin],
+                    contacts=Contacts([Sphere("body", 0.1)]))
+    with pytest.raises(ValueError, match="baumgarte"):
+        rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3, constraints=[pin], baumgarte=(-1.0, 0.0))

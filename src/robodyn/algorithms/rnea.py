@@ -222,6 +222,15 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
     return result
 
 
+def external_wrenches(model, f_ext, frame: str = "local") -> tuple[np.ndarray, np.int64]:
+    """One state's external wrenches for the compiled kernels: ``(F, code)`` with ``F``
+    (nbodies, 6) ``[force, torque]`` (checked: shape, finite) and ``code`` the kernels' frame
+    code of ``frame`` (``"local"``, ``"world"``, ``"local_world_aligned"``; see :func:`rnea`),
+    ``NO_WRENCH`` for ``f_ext=None``."""
+    F, code = _inputs.body_wrenches(model, f_ext, (), frame)
+    return F, np.int64(code)
+
+
 def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
          armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Inverse dynamics: the joint forces that produce acceleration ``a`` at state ``(q, v)``.

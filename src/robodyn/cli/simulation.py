@@ -218,7 +218,8 @@ def cmd_simulate(args) -> int:
               f"largest solver residual {traj.solver_residual.max():.3g} m/s")
     print(f"  energy: start {traj.energy[0]:.6g} J, end {traj.energy[-1]:.6g} J, max |E - E0| {drift:.3g} J")
     if traj.tracking_error is not None:
-        print(f"  tracking error: max {np.abs(traj.tracking_error).max():.3g}, final {np.abs(traj.tracking_error[-1]).max():.3g}")
+        error = np.abs(traj.tracking_error)
+        print(f"  tracking error: max {error.max():.3g}, final {error[-1].max():.3g}")
     if traj.lyapunov is not None:
         print(f"  Lyapunov function: start {traj.lyapunov[0]:.6g}, end {traj.lyapunov[-1]:.6g}, "
               f"largest increase over a step {max(np.diff(traj.lyapunov).max(), 0.0):.3g}")

@@ -247,7 +247,8 @@ class Contacts:
                 b, R, p = moving_frame(model, s.body)
             except (KeyError, ValueError, IndexError) as e:
                 raise ValueError(f"Contacts.shapes[{k}]: {e}") from None
-            base = s.name or (s.body if isinstance(s.body, str) else model.link_names[b]) + f":{type(s).__name__.lower()}"
+            base = s.name or (s.body if isinstance(s.body, str) else model.link_names[b]) \
+                + f":{type(s).__name__.lower()}"
             for (c, r), lab in zip(*s.spheres()):
                 bodies.append(b)
                 centers.append(p + R @ c)

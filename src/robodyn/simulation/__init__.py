@@ -11,4 +11,5 @@ from .trajectory import Trajectory
 from .linearize import linearize
 from .rollout import Rollouts, rollout
 
-__all__ = ["simulate", "rollout", "Rollouts", "linearize", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]
+__all__ = ["simulate", "rollout", "Rollouts", "linearize", "Trajectory", "read_csv", "coordinate_names", "INTEGRATORS",
+           "SCIPY_INTEGRATORS"]

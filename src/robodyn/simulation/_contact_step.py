@@ -18,8 +18,9 @@ from ..algorithms.crba import crba_one
 from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..algorithms.status import CHECKED, NO_WRENCH, NONFINITE_RESULT, OK, finite
-from ..contact.solver import (ACTIVE, BOUNCE_SPEED, INFO_SIZE, ITERATIONS, MARGIN, MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL,
+from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
+from ..contact.solver import (ACTIVE, BOUNCE_SPEED, INFO_SIZE, ITERATIONS, MARGIN, MAX_CORRECTION, MAX_ITERATIONS,
+                              RESIDUAL,
                               STABILIZATION, TOLERANCE, backward, cholesky, contact_frame, delassus, forward, solve,
                               point_rows)
 from ..control.laws import law_torque
@@ -96,7 +97,7 @@ def _dot(a, b):
 
 
 @core
-def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
          tau, a, q1, v1, force, dist, warm, info, ws):
     """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
     state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
@@ -107,7 +108,7 @@ def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, se
     nv = v.shape[0]
     for k in range(nv):
         tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, NO_WRENCH, CHECKED, h, rws)
+    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
     if st != OK:
         return st
     st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
@@ -192,10 +193,10 @@ def step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, se
 
 
 @kernel
-def step_kernel(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+def step_kernel(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
                 tau, a, q1, v1, force, dist, warm, info, ws):
     """Compiled :func:`step` for the Python-driven controllers."""
-    return step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+    return step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
                 tau, a, q1, v1, force, dist, warm, info, ws)
 
 
@@ -208,8 +209,8 @@ def run_workspace(nb, nv, npairs, ncb, nq):
 
 
 @inline
-def run_steps(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii,
-              surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws):
+def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
+              radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws):
     """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
     ``simulate._run_compiled``), writing ``Q[1:], V[1:]`` and, for every sample but the last
     unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
@@ -221,8 +222,8 @@ def run_steps(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coef
         q, v = Q[s], V[s]
         st = law_torque(law, c, gains, breaks, coefs, (s0 + s) * dt, q, v, tau_cmd, law_ws, cmd)
         if st == OK:
-            st = step(ints, body, dofs, params, fext, limit, points, centers, radii, surf, settings, q, v, cmd, dt,
-                      T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], ws)
+            st = step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, cmd,
+                      dt, T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], ws)
         if st != OK:
             return st, s
         if s < n:
@@ -234,12 +235,12 @@ def run_steps(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coef
 
 
 @kernel
-def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii, surf,
-        settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
+def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii,
+        surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
     """:func:`run_steps` of one simulation."""
     rws = run_workspace(ints.shape[0], V.shape[1], D.shape[1], c[0].shape[0], Q.shape[1])
-    return run_steps(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
-                     radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws)
+    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws)
 
 
 @kernel
@@ -270,8 +271,8 @@ def rollout_at(args, b, rws):
     """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
     ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
     ``args[-1][b]``."""
-    (ints, body, dofs, params, fext, limit, c0, c1, c2, c3, c4, c5, law, gains, breaks, coefs, tau_cmd, points,
-     centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed) = args
+    (ints, body, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, law, gains, breaks, coefs, tau_cmd,
+     points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed) = args
     c = (c0, c1, c2, c3, c4, c5)  # the law's model, flat in ``args`` (a parallel loop takes no nested tuple)
     warm, Qs, Vs, As, Ts, Fs, Ds, Is = rws[5], rws[6], rws[7], rws[8], rws[9], rws[10], rws[11], rws[12]
     for p in range(warm.shape[0]):
@@ -285,7 +286,7 @@ def rollout_at(args, b, rws):
         for r in range(Vs.shape[1]):
             Vs[0, r] = V[b, k, r]
         m = 1 if last else every + 1
-        st, s = run_steps(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+        st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
                           centers, radii, surf, settings, k * every, dt, last, Qs[:m], Vs[:m], As[:m], Ts[:m],
                           Fs[:m], Ds[:m], Is[:m], warm, rws)
         if st != OK:

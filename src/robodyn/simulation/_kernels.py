@@ -22,7 +22,7 @@ import numpy as np
 
 from .._jit import inline, kernel
 from ..layout import IQ, IV, JTYPE
-from ..algorithms.status import CHECKED, NO_WRENCH, OK
+from ..algorithms.status import CHECKED, OK
 from ..control.laws import law_torque
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
@@ -96,12 +96,12 @@ def chart_rate(ints, q, theta, v, R, out):
 
 
 @inline
-def derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, check, tau, thetadot, a, R, ws):
+def derivative(ints, body, dofs, params, fext, fcode, limit, q, theta, v, tau_cmd, check, tau, thetadot, a, R, ws):
     """State derivative ``(theta', a)`` at ``q = q0 ⊞ theta``, velocity ``v``, for the command
     ``tau_cmd`` clipped to ``[-limit, limit]`` (written to ``tau``). Returns the ABA status."""
     for k in range(tau.shape[0]):
         tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    status = aba_one(ints, body, dofs, params, q, v, tau, fext, NO_WRENCH, check, a, ws)
+    status = aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, a, ws)
     chart_rate(ints, q, theta, v, R, thetadot)
     return status
 
@@ -125,13 +125,14 @@ def rate(ints, q, theta, v, R, out):
 
 
 @kernel
-def stage(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, tau, thetadot, a, ws, R):
+def stage(ints, body, dofs, params, fext, fcode, limit, q, theta, v, tau_cmd, tau, thetadot, a, ws, R):
     """Compiled ``derivative`` (with the NaN/Inf check) for the Python-driven integrators."""
-    return derivative(ints, body, dofs, params, fext, limit, q, theta, v, tau_cmd, CHECKED, tau, thetadot, a, R, ws)
+    return derivative(ints, body, dofs, params, fext, fcode, limit, q, theta, v, tau_cmd, CHECKED, tau, thetadot, a, R,
+                      ws)
 
 
 @kernel
-def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, s0, dt,
+def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, method, q0, v0, s0, dt,
         Q, V, A, T):
     """Integrate from ``(q0, v0)`` at time ``s0 dt`` (sample ``s0``) with ``Q.shape[0] - 1`` steps of ``dt`` under
     a compiled control law (``law``, see ``law_torque``; ``CONSTANT`` applies ``tau_cmd``);
@@ -156,7 +157,8 @@ def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau
         th[:] = 0.0
         st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, cmd)
         if st == OK:
-            st = derivative(ints, body, dofs, params, fext, limit, q, th, v, cmd, CHECKED, T[s], kt[0], A[s], R, ws)
+            st = derivative(ints, body, dofs, params, fext, fcode, limit, q, th, v, cmd, CHECKED, T[s], kt[0], A[s], R,
+                            ws)
         if st != OK:
             return st, s
         if s == n:
@@ -178,7 +180,8 @@ def run(ints, body, dofs, params, fext, limit, c, law, gains, breaks, coefs, tau
             chart_point(ints, q, thi, qi)
             st = law_torque(law, c, gains, breaks, coefs, t + h, qi, vi, tau_cmd, cws, cmd)
             if st == OK:
-                st = derivative(ints, body, dofs, params, fext, limit, qi, thi, vi, cmd, CHECKED, tau, kt[j], ka[j], R, ws)
+                st = derivative(ints, body, dofs, params, fext, fcode, limit, qi, thi, vi, cmd, CHECKED, tau, kt[j],
+                                ka[j], R, ws)
             if st != OK:
                 return st, s
         for k in range(nv):

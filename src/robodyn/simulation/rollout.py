@@ -7,9 +7,10 @@ same robot, controller and contacts, each the time stepping of :func:`robodyn.si
 contacts (with or without them: a step solves ``M (v+ - v) = dt (tau - h) + J^T P``, the
 free and planar joints' linear velocities stepped in a frame that does not turn with the body,
 see ``_contact_step.moving_frame_terms``; for other joints it is ``simulate``'s
-semi-implicit Euler), run on all threads in compiled code (as MuJoCo's ``rollout``). Each rollout equals the single simulation from its initial state to
-the last bit. The controller must run in compiled code: None, ``control.PDGravity``,
-``ComputedTorque`` or ``JointPD``.
+semi-implicit Euler), run on all threads in compiled code (as MuJoCo's ``rollout``). Each
+rollout equals the single simulation with contacts from its initial state to the last bit.
+The controller must run in compiled code: None, ``control.PDGravity``, ``ComputedTorque`` or
+``JointPD``.
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..algorithms.driver import batch_kernel, chunks
-from ..algorithms.status import OK
+from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
 from ..errors import RobodynWarning
 from . import _contact_step as CK
@@ -105,7 +106,8 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
     k = model.kernel
     c, law, gains, breaks, coefs = _law_arrays(model, compiled)
-    args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench, np.ascontiguousarray(model.effort_limit),
+    args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
+            np.ascontiguousarray(model.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
             Q, V, A, T, Fc, D, info, failed)
     _batch(args, (model.nbodies, model.nv, npairs, c[0].shape[0], model.nq, int(every)), status, chunks(B))

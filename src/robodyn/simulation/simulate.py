@@ -20,6 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from .. import joints as J
+from ..algorithms.rnea import external_wrenches, rnea
 from ..algorithms.status import OK, raise_for_status
 from ..contact import solver as CS
 from ..control.laws import CONSTANT
@@ -111,14 +112,40 @@ class _Law:
 
 
 class _Plant:
-    """The model's kernel arrays and the Python-driven stages of the integrators."""
+    """The model's kernel arrays and the Python-driven stages of the integrators, with the
+    external wrenches (``f_ext``: None, an (nb, 6) array, or a callable ``(t, q, v) -> (nb, 6)``
+    in ``frame``) and bilateral ``constraints`` (Baumgarte ``(alpha, beta)``)."""
 
-    def __init__(self, model):
+    def __init__(self, model, f_ext=None, frame="local", constraints=(), baumgarte=(0.0, 0.0)):
         k = model.kernel
-        self.model = model
-        self.args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench,
+        self.model, self.frame = model, frame
+        self.wrench = f_ext if callable(f_ext) else None
+        fext, fcode = external_wrenches(model, None if callable(f_ext) else f_ext, frame)
+        self.args = (k.ints, k.body, k.dofs[True, True], k.params[True], fext, fcode,
                      np.ascontiguousarray(model.effort_limit))
+        self.constraints, self.baumgarte = tuple(constraints), baumgarte
+        self.constraint_force = None
         self.ws, self.R = K.stage_workspace(model.nbodies, model.nq, model.nv)
+
+    def keep(self, s: int) -> None:
+        """Sample ``s``'s constraint forces (those of its first stage), when constrained."""
+        if self.constraints:
+            self.CF[s] = self.constraint_force
+
+    @property
+    def compiled(self) -> bool:
+        """True when the whole run may be compiled (no Python callable on the way)."""
+        return self.wrench is None and not self.constraints
+
+    def args_at(self, t, q, v):
+        """The kernel arguments at ``(t, q, v)``: the callable wrenches evaluated there."""
+        if self.wrench is None:
+            return self.args
+        try:
+            fext, fcode = external_wrenches(self.model, self.wrench(t, q, v), self.frame)
+        except ValueError as e:
+            raise ValueError(f"f_ext at t = {t:.6g}: {e}") from None
+        return self.args[:4] + (fext, fcode) + self.args[6:]
 
     # The kernels take C-contiguous arrays only (SciPy's integrators hand over strided views),
     # so that each compiles once.
@@ -132,16 +159,41 @@ class _Plant:
         """``(theta', a, z')`` into the given arrays; the applied torque into ``tau``."""
         law.rate(t, q, v, z, zdot)
         cmd = _command(law, t, q, v, z, self.model.nv)
-        status = K.stage(*self.args, q, np.ascontiguousarray(theta), np.ascontiguousarray(v), cmd, tau, thetadot, a,
+        args = self.args_at(t, q, v)
+        if self.constraints:
+            self._constrained(args, t, q, theta, v, cmd, tau, thetadot, a)
+            return
+        status = K.stage(*args, q, np.ascontiguousarray(theta), np.ascontiguousarray(v), cmd, tau, thetadot, a,
                          self.ws, self.R)
         if status != OK:
             _raise(self.model, status, t, q, v, cmd)
+
+    def _constrained(self, args, t, q, theta, v, cmd, tau, thetadot, a):
+        """The constrained stage: ``a`` of :func:`constrained_dynamics` under the clipped command
+        plus the external wrenches' joint forces ``sum J^T f = rnea(q, 0, 0) - rnea(q, 0, 0, f)``;
+        the constraint forces into ``self.constraint_force``."""
+        from ..algorithms.constrained import constrained_dynamics
+
+        model, zero = self.model, np.zeros(self.model.nv)
+        np.clip(cmd, -args[6], args[6], out=tau)
+        total = tau.copy()
+        if args[5] >= 0:
+            total += rnea(model, q, zero, zero) - rnea(model, q, zero, zero, args[4], self.frame)
+        try:
+            res = constrained_dynamics(model, q, v, total, self.constraints, self.baumgarte)
+        except ValueError as e:
+            raise ValueError(f"simulate at t = {t:.6g}: {e}; the motion diverged or the controller returned NaN/Inf") \
+                from None
+        a[:] = res.a
+        self.constraint_force = np.concatenate([np.ravel(f) for f in res.forces])
+        self.rate(q, theta, v, thetadot)
 
 
 def _raise(model, status, t, q, v, tau):
     """The error of an ABA status at time ``t``."""
     try:
-        bad = raise_for_status(model, status, {"q": q, "v": v, "tau (controller output)": tau}, f"simulate at t = {t:.6g}")
+        bad = raise_for_status(model, status, {"q": q, "v": v, "tau (controller output)": tau},
+                               f"simulate at t = {t:.6g}")
     except ValueError as e:
         raise ValueError(f"{e}; the motion diverged or the controller returned NaN/Inf") from None
     raise ValueError(f"simulate at t = {t:.6g}: the articulated inertia of body {bad - 1} "
@@ -149,7 +201,8 @@ def _raise(model, status, t, q, v, tau):
 
 
 def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str | None = None, *,
-             contacts=None, rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
+             contacts=None, f_ext=None, f_ext_frame: str = "local", constraints=None, baumgarte=None,
+             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
     """Simulate the robot from ``(q0, v0)`` for ``duration`` seconds, sampled every ``dt``.
 
     Args:
@@ -174,6 +227,18 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             :mod:`robodyn.contact.solver`), and the trajectory holds each pair's contact
             force and distance and the solver's sweeps and residual at every sample; a step
             whose solve did not reach the tolerance is reported in one warning.
+        f_ext: external wrenches ``[force, torque]`` on the bodies, (nbodies, 6) in
+            ``f_ext_frame`` (``"local"``, ``"world"``, ``"local_world_aligned"``, as
+            :func:`robodyn.rnea`): an array (constant, compiled runs stay compiled) or a callable
+            ``(t, q, v) -> (nbodies, 6)`` evaluated at every stage (a push, a spring to the
+            world, an interaction force).
+        constraints: bilateral constraints (:class:`robodyn.PointConstraint`,
+            ``WeldConstraint``, ``LoopConstraint``, ``DistanceConstraint``, ``CouplingConstraint``;
+            a closed chain, a pinned point) held by :func:`robodyn.constrained_dynamics` at every
+            stage with Baumgarte stabilisation ``baumgarte = (alpha, beta)`` (1/s; default
+            ``(0.1 / dt, 0.1 / dt)``, position errors decaying critically damped over about ten
+            steps), so that the loop stays closed over long runs; the constraint forces are
+            sampled into ``traj.constraint_force``. Not with contacts.
         progress: show a progress bar on stderr (None: when stderr is a terminal and the run
             has at least ``PROGRESS_STEPS`` steps).
 
@@ -207,7 +272,8 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if controller is not None and not callable(controller):
         raise ValueError(f"controller: expected None or a callable (t, q, v) -> tau, got {type(controller).__name__}")
     cmodel = getattr(controller, "model", None)
-    if cmodel is not None and (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
+    sizes = (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv))
+    if cmodel is not None and sizes != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
     unit_configuration(model, q0)
@@ -216,11 +282,24 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Q, V = np.empty((n + 1, model.nq)), np.empty((n + 1, model.nv))
     A, T = np.zeros((n + 1, model.nv)), np.zeros((n + 1, model.nv))
     bar = Progress(n, enabled=(n >= PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress)
-    plant, law = _Plant(model), _Law(controller, model)
+    if f_ext is not None and not callable(f_ext):
+        f_ext = np.array(f_ext, dtype=float)
+    constraints = () if constraints is None else (constraints if isinstance(constraints, (list, tuple))
+                                                 else (constraints,))
+    baumgarte = (0.1 / dt, 0.1 / dt) if baumgarte is None else baumgarte
+    if constraints and contacts is not None:
+        raise ValueError("constraints: not with contacts (bilateral constraints and contacts in one solve are not "
+                         "supported yet); model the contacts or the constraints alone")
+    plant, law = _Plant(model, f_ext, f_ext_frame, constraints, baumgarte), _Law(controller, model)
+    if constraints:
+        from ..algorithms.constrained import constrained_dynamics
+
+        held = constrained_dynamics(model, q0, v0, np.zeros(model.nv), constraints, baumgarte)  # checks them
+        plant.CF = np.zeros((n + 1, sum(np.size(f) for f in held.forces)))
     Z = np.empty((n + 1, law.nz))
     Z[0] = law.z0
     compiled = None
-    if integrator in INTEGRATORS and not law.stateful:
+    if integrator in INTEGRATORS and not law.stateful and plant.compiled:
         compiled = (CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
     touch = None
     if contacts is not None:
@@ -232,7 +311,12 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     else:
         _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
     bar.close()
-    return _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch)
+    traj = _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch)
+    if constraints:
+        from dataclasses import replace
+
+        traj = replace(traj, constraint_force=plant.CF)
+    return traj
 
 
 def unit_configuration(model, q0: np.ndarray, name: str = "q0") -> None:
@@ -333,8 +417,8 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
             cmd = _command(law, t[s], q, v, z, nv)
             law.rate(t[s], q, v, z, zdot)
             qn, vn = (Q[s + 1], V[s + 1]) if s < n else (np.empty(model.nq), np.empty(nv))
-            status = CK.step_kernel(*plant.args, *geometry, q, v, cmd, dt, T[s], A[s], qn, vn, touch.force[s],
-                                    touch.distance[s], warm, touch.info[s], ws)
+            status = CK.step_kernel(*plant.args_at(t[s], q, v), *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
+                                    touch.force[s], touch.distance[s], warm, touch.info[s], ws)
             if status != OK:
                 _raise(model, status, t[s], q, v, cmd)
             if s < n:
@@ -374,6 +458,7 @@ def _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar):
     for s in range(n + 1):
         q, v, z = Q[s], V[s], Z[s]
         plant.derivative(t[s], q, zero, v, law, z, T[s], kt[0], A[s], kz[0])
+        plant.keep(s)
         if s == n:
             break
         if integrator == "semi_implicit_euler":
@@ -412,6 +497,7 @@ def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
     for s in range(n + 1):
         q = Q[s]
         plant.derivative(t[s], q, zero, V[s], law, Z[s], T[s], dy[:nv], A[s], dy[2 * nv:])
+        plant.keep(s)
         if s == n:
             break
 

@@ -30,7 +30,9 @@ class Trajectory:
     (N, npairs, 3) the force each pair's surface applies to the robot (world axes, N; zero
     when apart), over the step that starts at the sample; ``contact_distance`` (N, npairs)
     the signed distance (m, negative: penetration); ``solver_iterations`` (N,) and
-    ``solver_residual`` (N,) (m/s) of the contact solve.
+    ``solver_residual`` (N,) (m/s) of the contact solve. With bilateral constraints:
+    ``constraint_force`` (N, m) their forces stacked in the order given (see
+    :func:`robodyn.constrained_dynamics`).
     """
 
     model: object = field(repr=False)
@@ -54,6 +56,7 @@ class Trajectory:
     contact_distance: np.ndarray | None = None
     solver_iterations: np.ndarray | None = None
     solver_residual: np.ndarray | None = None
+    constraint_force: np.ndarray | None = None
 
     @property
     def normal_force(self) -> np.ndarray | None:
