@@ -75,7 +75,7 @@ def test_simulate_a_quadruped_dropped_on_the_ground(tmp_path, capsys):
         assert main(["simulate", urdf, "--ground", "--duration", "2", "--contact-plot", str(png)]) == 0
     out = capsys.readouterr().out
     assert "controller stand" in out and "semi_implicit_euler" in out
-    assert "4 spheres of 0.02 m on the ground (FL_FOOT, FR_FOOT, HL_FOOT, HR_FOOT); at the end 4 touch" in out
+    assert "contacts: 4 on the ground (FL_FOOT, FR_FOOT, HL_FOOT, HR_FOOT); at the end 4 touch" in out
     with pytest.warns(rd.RobodynWarning, match="<contact>"):
         model = rd.load_urdf(urdf, floating_base=True)
     weight = float(out.split("normal forces sum to ")[1].split(" N")[0])
@@ -87,7 +87,7 @@ def test_ground_options_and_their_errors(capsys):
     # a fixed-base arm whose hand touches the floor: the contacts given by name
     assert main(["simulate", "panda", "--ground", "--contacts", "link7", "--duration", "0.3", "--controller",
                  "none", "--friction", "0.5"]) == 0
-    assert "1 spheres of 0.02 m on the ground (link7)" in capsys.readouterr().out
+    assert "contacts: 1 on the ground (link7)" in capsys.readouterr().out
     assert main(["simulate", "panda", "--contact-plot", "x.png"]) == 2
     assert "--contact-plot applies to --ground" in capsys.readouterr().err
     assert main(["simulate", "panda", "--ground", "--contacts", "nowhere"]) == 2

@@ -24,7 +24,7 @@ from robodyn import joints as J
 from robodyn import plots
 from robodyn.control import JointPD, laws
 from robodyn.algorithms.constrained import frame_kinematics
-from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere
+from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere, shapes_from_urdf
 from robodyn.random import random_model, random_state
 
 from conftest import example_robot_data_dir
@@ -323,6 +323,63 @@ def test_plot_contacts_draws_the_forces_and_the_cones_used(tmp_path):
     np.testing.assert_allclose(used[np.isfinite(used)], 1.0, rtol=1e-9)  # sliding: on the cones
     with pytest.raises(ValueError, match="has no contacts"):
         plots.plot_contacts(rd.simulate(BOX, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.01, 1e-3))
+
+
+URDF_WITH_COLLISIONS = """<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" iyy="0.01" izz="0.01"/></inertial>
+    <collision><origin xyz="0 0 -0.1"/><geometry><sphere radius="0.05"/></geometry></collision>
+    <collision><origin xyz="0.1 0 0" rpy="0 0 0.5"/><geometry><box size="0.2 0.1 0.05"/></geometry></collision>
+    <collision><geometry><cylinder radius="0.02" length="0.3"/></geometry></collision>
+    <collision><geometry><mesh filename="package://r/m.stl"/></geometry></collision>
+  </link>
+  <link name="foot"><collision><geometry><sphere radius="0.03"/></geometry></collision></link>
+  <joint name="fix" type="fixed"><parent link="base"/><child link="foot"/><origin xyz="0 0 -0.3"/></joint>
+</robot>"""
+
+
+def test_shapes_from_urdf_collisions():
+    with pytest.warns(rd.RobodynWarning, match=r"1 mesh collision geometries not read \(links base\)"):
+        shapes = shapes_from_urdf(URDF_WITH_COLLISIONS)
+    sphere, box, capsule, foot = shapes
+    assert isinstance(sphere, Sphere) and sphere.radius == 0.05 and sphere.center.tolist() == [0, 0, -0.1]
+    assert isinstance(box, Box) and box.size.tolist() == [0.2, 0.1, 0.05]
+    assert box.center.tolist() == [0.1, 0, 0] and box.rpy.tolist() == [0, 0, 0.5]
+    assert isinstance(capsule, Capsule) and capsule.radius == 0.02 and capsule.length == pytest.approx(0.26)
+    assert [s.name for s in shapes] == ["base:sphere0", "base:box1", "base:cylinder2", "foot:sphere0"]
+    assert foot.body == "foot"  # a link merged into base by a fixed joint: a frame of the model
+    assert [s.name for s in shapes_from_urdf(URDF_WITH_COLLISIONS, links=["foot"])] == ["foot:sphere0"]
+    # dropped on the ground, the free body rests on the foot sphere (the lowest shape)
+    model = rd.load_urdf(URDF_WITH_COLLISIONS, floating_base=True)
+    traj = rd.simulate(model, [0, 0, 1.0, 0, 0, 0, 1], np.zeros(6), 1.0, 1e-3,
+                       contacts=Contacts(shapes_from_urdf(URDF_WITH_COLLISIONS, links=["foot"])))
+    assert traj.q[-1, 2] == pytest.approx(0.33, abs=1e-9)
+    with pytest.raises(rd.ModelError, match="a cylinder"):
+        shapes_from_urdf(URDF_WITH_COLLISIONS, cylinders="error")
+    with pytest.raises(rd.ModelError, match=r"a mesh \(package://r/m.stl\)"):
+        shapes_from_urdf(URDF_WITH_COLLISIONS, meshes="error")
+    for geometry, match in (("", "expected one geometry in <geometry>, got 0"),
+                            ('<cone radius="1"/>', "unknown geometry <cone>"),
+                            ('<sphere radius="-1"/>', "sizes must be > 0"), ('<box size="1 1"/>', "needs 3 number")):
+        xml = f'<robot name="r"><link name="a"><collision><geometry>{geometry}</geometry></collision></link></robot>'
+        with pytest.raises(rd.ModelError, match=match):
+            shapes_from_urdf(xml)
+
+
+def test_anymal_stands_on_its_urdf_foot_spheres():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        path = example_robot_data_dir() / "anymal_b_simple_description/robots/anymal.urdf"
+        model = rd.load_urdf(path, floating_base=True)
+    feet = ["LF_FOOT", "RF_FOOT", "LH_FOOT", "RH_FOOT"]
+    shapes = shapes_from_urdf(path, links=feet)
+    assert [type(s) for s in shapes] == [Sphere] * 4 and {s.radius for s in shapes} == {0.031}
+    q0 = rd.random.random_configuration(model, np.random.default_rng(0)) * 0
+    q0[6] = 1.0
+    q0[2] = 0.7
+    traj = rd.simulate(model, q0, np.zeros(model.nv), 1.5, 1e-3, JointPD(model, q0, 200.0, 5.0),
+                       contacts=Contacts(shapes))
+    np.testing.assert_allclose(traj.normal_force[-1].sum(), model.total_mass * G, rtol=1e-6)
+    assert np.abs(traj.v[-1]).max() < 1e-3  # settling
 
 
 # --- MuJoCo on the same scenes ---------------------------------------------------------------

@@ -26,6 +26,8 @@ start posture, gains from ``--omega``, the mass matrix's diagonal and the robot'
 
 from __future__ import annotations
 
+from collections import Counter
+
 import numpy as np
 
 from .. import models
@@ -85,15 +87,26 @@ def leaf_tips(model) -> list:
 
 
 def ground_contacts(model, args):
-    """The contacts of ``--ground``: spheres of ``--contact-radius`` at ``--contacts`` (default
-    :func:`leaf_tips`) on the plane z = 0 with ``--friction`` and ``--restitution``."""
-    from ..contact import Contacts, Plane, Sphere
+    """The contacts of ``--ground`` on the plane z = 0 with ``--friction`` and ``--restitution``:
+    at each of ``--contacts`` (default :func:`leaf_tips`), a URDF's collision spheres, boxes
+    and cylinders (as capsules) on that link when it has some, else a sphere of
+    ``--contact-radius``."""
+    import warnings
+
+    from ..contact import Contacts, Plane, Sphere, shapes_from_urdf
+    from ..errors import RobodynWarning
 
     names = leaf_tips(model) if args.contacts is None else [n.strip() for n in args.contacts.split(",") if n.strip()]
     if not names:
         raise ValueError("--contacts: give at least one link or frame name")
+    urdf = []
+    if str(args.model).endswith(".urdf"):
+        with warnings.catch_warnings():  # a mesh-only link gets the sphere instead
+            warnings.simplefilter("ignore", RobodynWarning)
+            urdf = shapes_from_urdf(args.model, names, meshes="skip")
+    given = {s.body for s in urdf}
     try:
-        contacts = Contacts([Sphere(n, args.contact_radius) for n in names],
+        contacts = Contacts(urdf + [Sphere(n, args.contact_radius) for n in names if n not in given],
                             surfaces=[Plane(friction=args.friction, restitution=args.restitution)])
         contacts.pack(model)  # the names resolve on this model
         return contacts
@@ -211,8 +224,10 @@ def cmd_simulate(args) -> int:
         fn, ft = traj.normal_force[-1], traj.friction_force[-1]
         touching = fn > 0
         usage = (ft[touching] / (args.friction * fn[touching])).max() if touching.any() and args.friction > 0 else 0.0
-        print(f"  contacts: {len(traj.contact_names)} spheres of {args.contact_radius:g} m on the ground "
-              f"({', '.join(n.split(':')[0] for n in traj.contact_names)}); at the end {int(touching.sum())} touch, "
+        bodies = Counter(n.split(":")[0] for n in traj.contact_names)
+        print(f"  contacts: {len(traj.contact_names)} on the ground ("
+              + ", ".join(b if k == 1 else f"{b} x{k}" for b, k in bodies.items())
+              + f"); at the end {int(touching.sum())} touch, "
               f"normal forces sum to {fn.sum():.6g} N (weight {model.total_mass * 9.81:.6g} N), largest share of "
               f"a friction cone {usage:.3g}; deepest penetration {max(-traj.contact_distance.min(), 0.0):.3g} m; "
               f"largest solver residual {traj.solver_residual.max():.3g} m/s")

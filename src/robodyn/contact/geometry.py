@@ -93,9 +93,8 @@ class Point:
         return [(self.point, 0.0)], [""]
 
 
-def _placement(name, center, rpy):
-    c = _finite(f"{name}.center", center, (3,))
-    return c, rpy_to_matrix(_finite(f"{name}.rpy", rpy, (3,)))
+def _placement(center, rpy):
+    return center, rpy_to_matrix(rpy)
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,13 +110,15 @@ class Box:
 
     def __post_init__(self):
         object.__setattr__(self, "body", _body("Box.body", self.body))
+        object.__setattr__(self, "center", _finite("Box.center", self.center, (3,)))
+        object.__setattr__(self, "rpy", _finite("Box.rpy", self.rpy, (3,)))
         size = _finite("Box.size", self.size, (3,))
         if np.any(size <= 0):
             raise ValueError(f"Box.size: every edge must be > 0, got {size.tolist()}")
         object.__setattr__(self, "size", size)
 
     def spheres(self):
-        c, R = _placement("Box", self.center, self.rpy)
+        c, R = _placement(self.center, self.rpy)
         signs = [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
         corners = [c + R @ (0.5 * self.size * np.array(s)) for s in signs]
         labels = ["[" + "".join("+" if v > 0 else "-" for v in s) + "]" for s in signs]
@@ -139,11 +140,13 @@ class Capsule:
 
     def __post_init__(self):
         object.__setattr__(self, "body", _body("Capsule.body", self.body))
+        object.__setattr__(self, "center", _finite("Capsule.center", self.center, (3,)))
+        object.__setattr__(self, "rpy", _finite("Capsule.rpy", self.rpy, (3,)))
         object.__setattr__(self, "radius", _positive("Capsule.radius", self.radius))
         object.__setattr__(self, "length", _positive("Capsule.length", self.length, zero=True))
 
     def spheres(self):
-        c, R = _placement("Capsule", self.center, self.rpy)
+        c, R = _placement(self.center, self.rpy)
         h = 0.5 * self.length * R[:, 2]
         return [(c - h, self.radius), (c + h, self.radius)], ["[-]", "[+]"]
 
@@ -262,3 +265,45 @@ class Contacts:
             raise ValueError("Contacts: two contact pairs have the same name; name the shapes (name=...) apart")
         return (np.array(bodies, dtype=np.int64), np.array(centers, dtype=float).reshape(-1, 3),
                 np.array(radii, dtype=float)), surf, settings, names
+
+
+def shapes_from_urdf(source, links=None, *, cylinders: str = "capsule", meshes: str = "skip") -> list:
+    """The contact shapes of a URDF's ``<collision>`` elements (file path or XML string), on
+    the links (or the frames that fixed joints merge them into) that carry them: spheres,
+    boxes, and cylinders as capsules of the same radius and overall length (``cylinders=
+    "capsule"``, rounded ends; ``"error"`` refuses them). Meshes are not read: ``meshes="skip"``
+    leaves them out with one warning naming their links, ``"error"`` refuses them. ``links``:
+    None (every link) or the names of the links to read (the feet, say). Each shape is named
+    ``<link>:<geometry><k>`` (``k`` its rank on the link)."""
+    import warnings
+
+    from ..errors import ModelError, RobodynWarning
+    from ..io.urdf import read_collisions
+
+    if cylinders not in ("capsule", "error") or meshes not in ("skip", "error"):
+        raise ValueError(f"cylinders: 'capsule' or 'error', meshes: 'skip' or 'error'; got {cylinders!r}, {meshes!r}")
+    shapes, skipped, rank = [], [], {}
+    wanted = None if links is None else set(links)
+    for c in read_collisions(source):
+        if wanted is not None and c.link not in wanted:
+            continue
+        k = rank[c.link] = rank.get(c.link, -1) + 1
+        name = f"{c.link}:{c.kind}{k}"
+        if c.kind == "sphere":
+            shapes.append(Sphere(c.link, c.size[0], c.xyz, name=name))
+        elif c.kind == "box":
+            shapes.append(Box(c.link, c.size, c.xyz, c.rpy, name=name))
+        elif c.kind == "cylinder":
+            if cylinders == "error":
+                raise ModelError(f"{c.where}: a cylinder (cylinders='error'); use cylinders='capsule'")
+            radius, length = c.size
+            shapes.append(Capsule(c.link, radius, max(length - 2 * radius, 0.0), c.xyz, c.rpy, name=name))
+        elif meshes == "error":
+            raise ModelError(f"{c.where}: a mesh ({c.filename}) is not read as a contact shape")
+        else:
+            skipped.append(c.link)
+    if skipped:
+        warnings.warn(f"shapes_from_urdf: {len(skipped)} mesh collision geometries not read (links "
+                      f"{', '.join(dict.fromkeys(skipped))}); give their contact shapes in code", RobodynWarning,
+                      stacklevel=2)
+    return shapes

@@ -10,7 +10,8 @@ continuous joints always are), ``<dynamics damping friction>``.
 ``<mimic>`` joints load as independent joints with a warning. Elements without rigid-body
 dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
 reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
-dynamics and is skipped without a warning.
+dynamics and is skipped without a warning (:func:`read_collisions` reads the collision
+geometry, which :func:`robodyn.contact.shapes_from_urdf` turns into contact shapes).
 
 Lenient where the major loaders are: a byte-order mark or blank lines before ``<?xml ...?>``,
 a default ``xmlns`` on ``<robot>``, extension elements and attributes in other namespaces
@@ -27,6 +28,7 @@ from __future__ import annotations
 import math
 import warnings
 from collections import Counter
+from typing import NamedTuple
 
 import numpy as np
 
@@ -35,7 +37,7 @@ from ..errors import ModelError, RobodynWarning
 from ..model import Model
 from ._xml import MAX_DEPTH, parse, read_source
 
-__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "load_urdf"]
+__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "load_urdf", "read_collisions", "Collision"]
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
 
@@ -168,6 +170,52 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
         ixx, ixy, ixz, iyy, iyz, izz = (rd.floats(I_el, k, 1, (0.0,))[0] for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
         I = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
     b.add_link(lname, mass=mass, com=xyz, inertia=I, inertia_rotation=rpy_to_matrix(rpy), where=where)
+
+
+class Collision(NamedTuple):
+    """One ``<collision>`` geometry of a URDF link: ``kind`` ``"sphere"`` (``size = (radius,)``),
+    ``"box"`` (``size``: the three edges), ``"cylinder"`` (``(radius, length)``, along the
+    local z axis) or ``"mesh"`` (``size = ()``, ``filename`` set); ``xyz``, ``rpy`` the
+    element's ``<origin>`` in the link frame; ``where`` the file, element and line."""
+    link: str
+    kind: str
+    size: tuple
+    xyz: np.ndarray
+    rpy: np.ndarray
+    filename: str | None
+    where: str
+
+
+def read_collisions(source) -> list[Collision]:
+    """The ``<collision>`` geometry of every link of a URDF file (path) or XML string, in
+    file order, read with the safeguards of :func:`load_urdf`. A ``<collision>`` without a
+    geometry, an unknown geometry, or sizes that are not positive are a :class:`ModelError`."""
+    text, name = _read_source(source)
+    root, lines = parse(text, name)
+    rd = _Reader(name, lines)
+    out = []
+    for link in root:
+        if link.tag != "link":
+            continue
+        for col in link:
+            if col.tag != "collision":
+                continue
+            where = rd.where(col, f"<link name={link.get('name')!r}> <collision>")
+            geometry = _child(col, "geometry")
+            shapes = [] if geometry is None else [g for g in geometry if isinstance(g.tag, str)]
+            if len(shapes) != 1:
+                raise ModelError(f"{where}: expected one geometry in <geometry>, got {len(shapes)}")
+            g = shapes[0]
+            xyz, rpy = rd.origin(col)
+            sizes = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "mesh": ()}
+            if g.tag not in sizes:
+                raise ModelError(f"{where}: unknown geometry <{g.tag}>")
+            size = (tuple(rd.floats(g, "size", 3)) if g.tag == "box"
+                    else tuple(rd.floats(g, k, 1)[0] for k in sizes[g.tag]))
+            if any(x <= 0 for x in size):
+                raise ModelError(f"{where}: <{g.tag}> sizes must be > 0, got {list(size)}")
+            out.append(Collision(link.get("name"), g.tag, size, xyz, rpy, g.get("filename"), where))
+    return out
 
 
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
