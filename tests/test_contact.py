@@ -24,7 +24,7 @@ from robodyn import joints as J
 from robodyn import plots
 from robodyn.control import JointPD, laws
 from robodyn.algorithms.constrained import frame_kinematics
-from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere, shapes_from_urdf
+from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere, StaticBox, shapes_from_urdf
 from robodyn.random import random_model, random_state
 
 from conftest import example_robot_data_dir
@@ -189,6 +189,35 @@ def test_a_deep_start_is_pushed_out_at_a_bounded_speed():
     traj = rd.simulate(BALL, q0, np.zeros(6), 1.0, 1e-3, contacts=contacts)
     assert np.all(np.isfinite(traj.q)) and np.abs(traj.v[:, 2]).max() <= 0.5 + 1e-9
     assert abs(traj.q[-1, 2] - BALL_R) < 1e-3
+
+
+def test_static_boxes_are_tables_walls_and_steps():
+    table = StaticBox((1.0, 1.0, 0.4), center=(0, 0, 0.2), friction=0.5, name="table")
+    contacts = Contacts([Sphere("body", BALL_R)], surfaces=[Plane(), table])
+    traj = rd.simulate(BALL, [0.2, 0, 1.0, 0, 0, 0, 1], np.zeros(6), 1.0, 1e-3, contacts=contacts)
+    assert traj.contact_names == ("body:sphere@ground", "body:sphere@table")
+    assert traj.q[-1, 2] == pytest.approx(0.4 + BALL_R, abs=1e-9)  # on the table top
+    np.testing.assert_allclose(traj.contact_force[-1], [[0, 0, 0], [0, 0, BALL_M * G]], atol=1e-6)
+    np.testing.assert_allclose(traj.contact_normal[-1, 1], [0, 0, 1])
+    # rolling off its edge onto the floor
+    traj = rd.simulate(BALL, [0.3, 0, 0.4 + BALL_R, 0, 0, 0, 1], [1.0, 0, 0, 0, 0, 0], 1.5, 1e-3, contacts=contacts)
+    assert traj.q[-1, 0] > 0.5 + BALL_R and traj.q[-1, 2] == pytest.approx(BALL_R, abs=1e-9)
+    edge = traj.contact_normal[:, 1][traj.normal_force[:, 1] > 0]
+    assert edge[-1, 0] > 0.5  # it left over the edge, the normal turning towards +x
+    # a wall turned by 30 degrees about z: thrown at it, the ball stops against its face
+    wall = StaticBox((0.1, 2.0, 1.0), center=(1.0, 0, 0.5), rpy=(0, 0, np.pi / 6), friction=0.0)
+    n = np.array([-np.cos(np.pi / 6), -np.sin(np.pi / 6), 0.0])
+    traj = rd.simulate(BALL, [0, 0, BALL_R, 0, 0, 0, 1], [2.0, 0, 0, 0, 0, 0], 1.5, 1e-3,
+                       contacts=Contacts([Sphere("body", BALL_R)], surfaces=[Plane(friction=0.0), wall]))
+    hit = traj.normal_force[:, 1] > 0
+    assert hit.any() and np.allclose(traj.contact_normal[hit, 1], n, atol=1e-12)
+    centre_to_face = (traj.q[:, :3] - wall.center) @ n - 0.05
+    assert centre_to_face.min() > BALL_R - 1e-9  # never through the wall
+    # a start deep inside a step leaves through its nearest face, at a bounded speed
+    step = StaticBox((1.0, 1.0, 0.2), center=(0, 0, 0.1))
+    traj = rd.simulate(BALL, [0, 0, 0.15, 0, 0, 0, 1], np.zeros(6), 1.0, 1e-3,
+                       contacts=Contacts([Sphere("body", BALL_R)], surfaces=[step], max_correction=0.3))
+    assert np.abs(traj.v[:, 2]).max() <= 0.3 + 1e-9 and traj.q[-1, 2] == pytest.approx(0.2 + BALL_R, abs=1e-6)
 
 
 # --- identities with the other algorithms ---------------------------------------------------
@@ -430,11 +459,14 @@ def test_box_on_a_plane_agrees_with_mujoco():
     (lambda: Sphere("body", 0.0), "radius: must be > 0"),
     (lambda: Sphere("body", 0.1, center=(0, np.nan, 0)), "center: contains NaN"),
     (lambda: Box("body", (0.1, 0.0, 0.1)), "every edge must be > 0"),
+    (lambda: StaticBox((1.0, -1.0, 1.0)), "StaticBox.size: every edge must be > 0"),
+    (lambda: StaticBox((1.0, 1.0, 1.0), center=(0, np.inf, 0)), "StaticBox.center: contains NaN or Inf"),
+    (lambda: StaticBox((1.0, 1.0, 1.0), friction=-1), "StaticBox.friction: must be >= 0"),
     (lambda: Capsule("body", -0.1, 0.2), "radius: must be > 0"),
     (lambda: Sphere(1.5, 0.1), "expected a link or frame name"),
     (lambda: Contacts([]), "at least one shape"),
     (lambda: Contacts(["body"]), r"shapes\[0\]: expected a Sphere"),
-    (lambda: Contacts([Sphere("body", 0.1)], surfaces=["ground"]), r"surfaces\[0\]: expected a Plane"),
+    (lambda: Contacts([Sphere("body", 0.1)], surfaces=["ground"]), r"surfaces\[0\]: expected a Plane or a StaticBox"),
     (lambda: Contacts([Sphere("body", 0.1)], max_iterations=0), "max_iterations"),
     (lambda: Contacts([Sphere("body", 0.1)], tolerance=-1), "tolerance: must be > 0"),
     (lambda: Contacts([Sphere("body", 0.1)], stabilization=2), "stabilization: must lie in"),

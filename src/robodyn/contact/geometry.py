@@ -15,7 +15,9 @@ and a capsule's an end.
 
 World surfaces: :class:`Plane` ``(normal, height, friction, restitution)``, the half-space
 ``normal . x <= height`` being solid (the ground is ``Plane()``; an incline, a wall are
-planes with other normals). Friction (Coulomb coefficient ``mu``, isotropic) and
+planes with other normals), and :class:`StaticBox` ``(size, center, rpy, friction,
+restitution)``, an obstacle (a table, a step) that spheres touch at the nearest point of its
+surface. Friction (Coulomb coefficient ``mu``, isotropic) and
 restitution (Newton's coefficient ``e``) belong to the surface.
 
 :class:`Contacts` gathers the shapes, the surfaces and the solver's settings; it is what
@@ -179,7 +181,53 @@ class Plane:
         object.__setattr__(self, "restitution", e)
 
 
+@dataclass(frozen=True, eq=False)
+class StaticBox:
+    """A box fixed in the world (an obstacle, a table, a step): edge lengths ``size`` (3,),
+    centred at ``center`` and rotated by ``rpy`` (extrinsic X-Y-Z) in world coordinates; solid
+    inside. ``friction``, ``restitution`` as :class:`Plane`'s. Spheres and points touch it at
+    the nearest point of its surface (faces, edges, corners)."""
+
+    size: np.ndarray
+    center: np.ndarray = (0.0, 0.0, 0.0)
+    rpy: np.ndarray = (0.0, 0.0, 0.0)
+    friction: float = 1.0
+    restitution: float = 0.0
+    name: str = "box"
+
+    def __post_init__(self):
+        size = _finite("StaticBox.size", self.size, (3,))
+        if np.any(size <= 0):
+            raise ValueError(f"StaticBox.size: every edge must be > 0, got {size.tolist()}")
+        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "center", _finite("StaticBox.center", self.center, (3,)))
+        object.__setattr__(self, "rpy", _finite("StaticBox.rpy", self.rpy, (3,)))
+        object.__setattr__(self, "friction", _positive("StaticBox.friction", self.friction, zero=True))
+        e = _positive("StaticBox.restitution", self.restitution, zero=True)
+        if e > 1:
+            raise ValueError(f"StaticBox.restitution: must lie in [0, 1], got {e}")
+        object.__setattr__(self, "restitution", e)
+
+
+def _surface_row(s) -> np.ndarray:
+    """The row of ``solver``'s surface table for a :class:`Plane` or :class:`StaticBox`."""
+    from . import solver as S
+
+    row = np.zeros(S.SURFACE_COLUMNS)
+    row[S.FRICTION], row[S.RESTITUTION] = s.friction, s.restitution
+    if isinstance(s, Plane):
+        row[S.KIND] = S.PLANE
+        row[S.NORMAL:S.NORMAL + 3], row[S.HEIGHT] = s.normal, s.height
+    else:
+        row[S.KIND] = S.BOX
+        row[S.CENTER:S.CENTER + 3] = s.center
+        row[S.ROTATION:S.ROTATION + 9] = rpy_to_matrix(s.rpy).ravel()
+        row[S.HALF:S.HALF + 3] = 0.5 * s.size
+    return row
+
+
 SHAPES = (Sphere, Point, Box, Capsule)
+SURFACES = (Plane, StaticBox)
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,7 +235,8 @@ class Contacts:
     """Shapes on the robot, static surfaces, and the settings of the contact solver.
 
     ``shapes``: :class:`Sphere`, :class:`Point`, :class:`Box`, :class:`Capsule`;
-    ``surfaces``: :class:`Plane` (default: the ground ``z = 0`` with ``mu = 1``).
+    ``surfaces``: :class:`Plane`, :class:`StaticBox` (default: the ground ``z = 0`` with
+    ``mu = 1``).
 
     Solver settings (see :mod:`robodyn.contact.solver`): ``tolerance`` (m/s) the residual
     at which a step's solve stops (the largest velocity error of Coulomb's law, see
@@ -219,8 +268,8 @@ class Contacts:
                 raise ValueError(f"Contacts.shapes[{k}]: expected a Sphere, Point, Box or Capsule, got {s!r}")
         surfaces = tuple(self.surfaces) if isinstance(self.surfaces, (list, tuple)) else (self.surfaces,)
         for k, s in enumerate(surfaces):
-            if not isinstance(s, Plane):
-                raise ValueError(f"Contacts.surfaces[{k}]: expected a Plane, got {s!r}")
+            if not isinstance(s, SURFACES):
+                raise ValueError(f"Contacts.surfaces[{k}]: expected a Plane or a StaticBox, got {s!r}")
         if not shapes or not surfaces:
             raise ValueError("Contacts: needs at least one shape and one surface")
         object.__setattr__(self, "shapes", shapes)
@@ -239,7 +288,7 @@ class Contacts:
         """The kernel arrays of these contacts on ``model``: ``(points, surfaces, settings, names)``.
 
         ``points`` = ``(body (np,) int64, center (np, 3) in the body frame, radius (np,))``;
-        ``surfaces`` (ns, 6): ``[normal, height, friction, restitution]``; ``settings``
+        ``surfaces`` (ns, ``solver.SURFACE_COLUMNS``), one row per surface; ``settings``
         (``SETTINGS_SIZE``,); ``names``: one per pair, point-major (pair ``p ns + s``).
         """
         from ..algorithms.jacobian import moving_frame
@@ -257,7 +306,7 @@ class Contacts:
                 centers.append(p + R @ c)
                 radii.append(r)
                 labels.append(base + lab)
-        surf = np.array([[*s.normal, s.height, s.friction, s.restitution] for s in self.surfaces])
+        surf = np.array([_surface_row(s) for s in self.surfaces])
         settings = np.array([self.max_iterations, self.tolerance, self.stabilization, self.max_correction,
                              self.bounce_speed, self.margin], dtype=float)
         names = tuple(f"{lab}@{s.name}" for lab in labels for s in self.surfaces)

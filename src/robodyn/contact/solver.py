@@ -55,9 +55,50 @@ TAU, RHO_POWER, RHO_POWER_FACTOR, RATIO_PRIMAL_DUAL = 0.5, 0.2, 0.05, 3.0
 # ADMM iterations before the first active-set polish, and the polish's rounds per active set
 POLISH_AFTER, POLISH_ROUNDS = 100, 40
 
+# ``surfaces`` table columns (one row per surface, see ``geometry.Contacts.pack``): the kind,
+# Coulomb's mu and Newton's e, then a plane's unit normal and height (``n . x <= height`` is
+# solid) or a box's centre, rotation (row-major, box to world) and half edges
+KIND, FRICTION, RESTITUTION, NORMAL, HEIGHT, CENTER, ROTATION, HALF = 0, 1, 2, 3, 6, 3, 7, 16
+SURFACE_COLUMNS = 19
+PLANE, BOX = 0, 1
+
 # ``info`` entries of a step: the sweeps used, the last sweep's residual, the contacts solved
 ITERATIONS, RESIDUAL, ACTIVE = range(3)
 INFO_SIZE = 3
+
+
+@inline
+def surface_distance(row, x, radius, n):
+    """Signed distance (m) from the sphere of centre ``x`` (world) and ``radius`` to the solid
+    surface of the table row ``row``, and the surface's outward unit normal at the nearest
+    point into ``n`` (3,). A box: the nearest point of its surface from the centre taken in
+    the box's frame (clamped to the half edges outside, the nearest face inside)."""
+    if row[KIND] == PLANE:
+        for r in range(3):
+            n[r] = row[NORMAL + r]
+        return n[0] * x[0] + n[1] * x[1] + n[2] * x[2] - row[HEIGHT] - radius
+    d0, d1, d2 = x[0] - row[CENTER], x[1] - row[CENTER + 1], x[2] - row[CENTER + 2]
+    p0 = row[ROTATION] * d0 + row[ROTATION + 3] * d1 + row[ROTATION + 6] * d2  # R^T (x - c)
+    p1 = row[ROTATION + 1] * d0 + row[ROTATION + 4] * d1 + row[ROTATION + 7] * d2
+    p2 = row[ROTATION + 2] * d0 + row[ROTATION + 5] * d1 + row[ROTATION + 8] * d2
+    h0, h1, h2 = row[HALF], row[HALF + 1], row[HALF + 2]
+    e0, e1, e2 = p0 - min(max(p0, -h0), h0), p1 - min(max(p1, -h1), h1), p2 - min(max(p2, -h2), h2)
+    out = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    if out > 0.0:
+        b0, b1, b2, phi = e0 / out, e1 / out, e2 / out, out - radius
+    else:  # the centre inside: out through the nearest face
+        g0, g1, g2 = h0 - abs(p0), h1 - abs(p1), h2 - abs(p2)
+        b0, b1, b2 = 0.0, 0.0, 0.0
+        if g0 <= g1 and g0 <= g2:
+            b0, depth = (1.0 if p0 >= 0.0 else -1.0), g0
+        elif g1 <= g2:
+            b1, depth = (1.0 if p1 >= 0.0 else -1.0), g1
+        else:
+            b2, depth = (1.0 if p2 >= 0.0 else -1.0), g2
+        phi = -depth - radius
+    for r in range(3):  # R b
+        n[r] = row[ROTATION + 3 * r] * b0 + row[ROTATION + 3 * r + 1] * b1 + row[ROTATION + 3 * r + 2] * b2
+    return phi
 
 
 @inline

@@ -19,8 +19,8 @@ from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
-from ..contact.solver import (ACTIVE, BOUNCE_SPEED, INFO_SIZE, ITERATIONS, MARGIN, MAX_CORRECTION, MAX_ITERATIONS,
-                              RESIDUAL,
+from ..contact.solver import (ACTIVE, BOUNCE_SPEED, FRICTION, INFO_SIZE, ITERATIONS, MARGIN, MAX_CORRECTION,
+                              MAX_ITERATIONS, RESIDUAL, RESTITUTION, surface_distance,
                               STABILIZATION, TOLERANCE, backward, cholesky, contact_frame, delassus, forward, solve,
                               point_rows)
 from ..control.laws import law_torque
@@ -37,7 +37,7 @@ def workspace(nb, nv, npairs):
             np.zeros(nv), np.empty((m3, nv)), np.empty((nv, m3)), np.empty((m3, m3)), np.empty(m3),
             np.empty(npairs), np.empty(npairs), np.empty(m3), np.empty((npairs, 3, 3)),
             np.empty(npairs, np.int64), np.empty((3, 3)), np.empty(nv), np.empty(3),
-            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))))
+            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))), np.empty(3))
 
 
 @inline
@@ -98,13 +98,13 @@ def _dot(a, b):
 
 @core
 def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
-         tau, a, q1, v1, force, dist, warm, info, ws):
+         tau, a, q1, v1, force, geom, warm, info, ws):
     """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
     state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
-    signed distance (m) at ``q``, the solver's ``info`` (sweeps, residual, active contacts;
+    geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the solver's ``info`` (sweeps, residual, active contacts;
     converged when the residual is at most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous
     step's impulses in the contact frames (read and written). Returns a status."""
-    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws = ws
+    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws, nrm = ws
     nv = v.shape[0]
     for k in range(nv):
         tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
@@ -132,12 +132,13 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             x[r] = op[b, r] + oR[b, r, 0] * centers[p, 0] + oR[b, r, 1] * centers[p, 1] + oR[b, r, 2] * centers[p, 2]
         for s in range(ns):
             pair = p * ns + s
-            phi = surf[s, 0] * x[0] + surf[s, 1] * x[1] + surf[s, 2] * x[2] - surf[s, 3] - rad
-            dist[pair] = phi
+            phi = surface_distance(surf[s], x, rad, nrm)
+            geom[pair, 0] = phi
             for r in range(3):
+                geom[pair, 1 + r] = nrm[r]
                 force[pair, r] = 0.0
             F, rows = frames[m], Jc[3 * m:3 * m + 3]
-            contact_frame(surf[s], F)
+            contact_frame(nrm, F)
             for r in range(3):  # the sphere's point nearest the surface
                 tmp[r] = x[r] - rad * F[0, r]
             point_rows(ints, oS, b, tmp[:3], F, rows)
@@ -150,9 +151,10 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
                 target = -phi / dt
             else:  # push out, at a bounded speed
                 target = min(settings[STABILIZATION] * -phi / dt, settings[MAX_CORRECTION])
-            if surf[s, 5] > 0.0 and u_before < -settings[BOUNCE_SPEED] and phi + dt * u_free < 0.0:
-                target = max(target, -surf[s, 5] * u_before)  # Newton's impact law
-            bias[m], mu[m], pair_of[m] = target, surf[s, 4], pair
+            e = surf[s, RESTITUTION]
+            if e > 0.0 and u_before < -settings[BOUNCE_SPEED] and phi + dt * u_free < 0.0:
+                target = max(target, -e * u_before)  # Newton's impact law
+            bias[m], mu[m], pair_of[m] = target, surf[s, FRICTION], pair
             for r in range(3):
                 P[3 * m + r] = warm[pair, r]
             m += 1
@@ -194,10 +196,10 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
 
 @kernel
 def step_kernel(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
-                tau, a, q1, v1, force, dist, warm, info, ws):
+                tau, a, q1, v1, force, geom, warm, info, ws):
     """Compiled :func:`step` for the Python-driven controllers."""
     return step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
-                tau, a, q1, v1, force, dist, warm, info, ws)
+                tau, a, q1, v1, force, geom, warm, info, ws)
 
 
 @kernel
@@ -250,7 +252,7 @@ def rollout_workspace(nb, nv, npairs, ncb, nq, every):
     m = every + 1
     return run_workspace(nb, nv, npairs, ncb, nq) + (
         np.empty((m, nq)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, npairs, 3)),
-        np.empty((m, npairs)), np.empty((m, INFO_SIZE)))
+        np.empty((m, npairs, 4)), np.empty((m, INFO_SIZE)))
 
 
 @inline
@@ -259,9 +261,10 @@ def _keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
     for r in range(A.shape[1]):
         A[k, r], T[k, r] = As[j, r], Ts[j, r]
     for p in range(D.shape[1]):
-        D[k, p] = Ds[j, p]
         for r in range(3):
             Fc[k, p, r] = Fs[j, p, r]
+        for r in range(4):
+            D[k, p, r] = Ds[j, p, r]
     for r in range(info.shape[1]):
         info[k, r] = Is[j, r]
 

@@ -34,7 +34,8 @@ _batch = batch_kernel(CK.rollout_at, CK.rollout_workspace)
 class Rollouts:
     """``B`` rollouts sampled at ``t`` (N,): ``q`` (B, N, nq), ``v``, ``a``, ``tau`` (B, N, nv)
     (as :class:`Trajectory`'s); with contacts ``contact_names``, ``contact_force``
-    (B, N, npairs, 3), ``contact_distance`` (B, N, npairs), ``solver_iterations`` and
+    (B, N, npairs, 3), ``contact_distance`` (B, N, npairs), ``contact_normal`` (B, N, npairs,
+    3), ``solver_iterations`` and
     ``solver_residual`` (B, N)."""
 
     model: object = field(repr=False)
@@ -46,6 +47,7 @@ class Rollouts:
     contact_names: tuple = ()
     contact_force: np.ndarray | None = None
     contact_distance: np.ndarray | None = None
+    contact_normal: np.ndarray | None = None
     solver_iterations: np.ndarray | None = None
     solver_residual: np.ndarray | None = None
 
@@ -92,7 +94,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
         (points, centers, radii), surf, settings, names = contacts.pack(model)
     else:
         points, centers, radii = np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0)
-        surf, settings, names = np.zeros((0, 6)), np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0]), ()
+        surf, settings, names = np.zeros((0, CS.SURFACE_COLUMNS)), np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0]), ()
     n = max(1, int(round(duration / dt)))
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1 or n % every:
         raise ValueError(f"every: expected an integer >= 1 dividing the {n} steps, got {every!r}")
@@ -102,7 +104,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     V[:, 0] = v0
     unit_configuration(model, Q[:, 0])
     A, T = np.zeros((B, N, model.nv)), np.zeros((B, N, model.nv))
-    Fc, D, info = np.zeros((B, N, npairs, 3)), np.zeros((B, N, npairs)), np.zeros((B, N, CS.INFO_SIZE))
+    Fc, D, info = np.zeros((B, N, npairs, 3)), np.zeros((B, N, npairs, 4)), np.zeros((B, N, CS.INFO_SIZE))
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
     k = model.kernel
     c, law, gains, breaks, coefs = _law_arrays(model, compiled)
@@ -129,4 +131,5 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
                       f"{int((residual > contacts.warn_above).sum())} of {residual.size} steps (largest residual "
                       f"{residual[worst]:.3g} m/s in rollout {worst[0]} at t = {t[worst[1]]:.6g})",
                       RobodynWarning, stacklevel=2)
-    return Rollouts(model, t, Q, V, A, T, names, Fc, D, info[..., CS.ITERATIONS].astype(np.int64), residual)
+    return Rollouts(model, t, Q, V, A, T, names, Fc, D[..., 0], D[..., 1:], info[..., CS.ITERATIONS].astype(np.int64),
+                    residual)

@@ -372,13 +372,13 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
 
 
 class Touch(NamedTuple):
-    """The contact samples of a run: pair names, each pair's surface normal (npairs, 3) and
-    friction (npairs,), forces (N, npairs, 3), distances (N, npairs), solver info (N, 3)."""
+    """The contact samples of a run: pair names, each pair's friction (npairs,), forces
+    (N, npairs, 3), geometry (N, npairs, 4: signed distance and surface normal), solver info
+    (N, 3)."""
     names: tuple
-    normal: np.ndarray
     friction: np.ndarray
     force: np.ndarray
-    distance: np.ndarray
+    geometry: np.ndarray
     info: np.ndarray
 
 
@@ -390,9 +390,9 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
     (points, centers, radii), surf, settings, names = contacts.pack(model)
     N, nv, nz = Q.shape[0], model.nv, Z.shape[1]
     n = N - 1
-    pair_surface = surf[np.arange(len(names)) % surf.shape[0]]
-    touch = Touch(names, pair_surface[:, :3].copy(), pair_surface[:, 4].copy(), np.zeros((N, len(names), 3)),
-                  np.zeros((N, len(names))), np.zeros((N, CS.INFO_SIZE)))
+    friction = surf[np.arange(len(names)) % surf.shape[0], CS.FRICTION]
+    touch = Touch(names, friction, np.zeros((N, len(names), 3)), np.zeros((N, len(names), 4)),
+                  np.zeros((N, CS.INFO_SIZE)))
     warm = np.zeros((len(names), 3))
     geometry = (points, centers, radii, surf, settings)
     Q[0], V[0] = q0, v0
@@ -403,7 +403,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
         for a in range(0, n, piece):
             b = min(n, a + piece)
             status, s = CK.run(*plant.args, c, code, gains, breaks, coefs, zero, *geometry, a, dt, b == n, Q[a:b + 1],
-                               V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.distance[a:b + 1],
+                               V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
                                touch.info[a:b + 1], warm)
             if status != OK:
                 _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
@@ -418,7 +418,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
             law.rate(t[s], q, v, z, zdot)
             qn, vn = (Q[s + 1], V[s + 1]) if s < n else (np.empty(model.nq), np.empty(nv))
             status = CK.step_kernel(*plant.args_at(t[s], q, v), *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
-                                    touch.force[s], touch.distance[s], warm, touch.info[s], ws)
+                                    touch.force[s], touch.geometry[s], warm, touch.info[s], ws)
             if status != OK:
                 _raise(model, status, t[s], q, v, cmd)
             if s < n:
@@ -544,7 +544,8 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
                       controller_state=Z if law.stateful else None, integrator=integrator,
                       **({} if touch is None else dict(
-                          contact_names=touch.names, contact_normal=touch.normal, contact_friction=touch.friction,
-                          contact_force=touch.force, contact_distance=touch.distance,
+                          contact_names=touch.names, contact_normal=touch.geometry[..., 1:],
+                          contact_friction=touch.friction, contact_force=touch.force,
+                          contact_distance=touch.geometry[..., 0],
                           solver_iterations=touch.info[:, CS.ITERATIONS].astype(np.int64),
                           solver_residual=touch.info[:, CS.RESIDUAL])))

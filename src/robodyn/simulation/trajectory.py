@@ -26,7 +26,8 @@ class Trajectory:
     controller that has one (see :func:`robodyn.simulate`), else None.
 
     With contacts: ``contact_names`` the pairs ``"<shape>@<surface>"``, ``contact_normal``
-    (npairs, 3) and ``contact_friction`` (npairs,) their surface's normal and ``mu``; ``contact_force``
+    (N, npairs, 3) the surface's outward normal at each pair's nearest point and
+    ``contact_friction`` (npairs,) its ``mu``; ``contact_force``
     (N, npairs, 3) the force each pair's surface applies to the robot (world axes, N; zero
     when apart), over the step that starts at the sample; ``contact_distance`` (N, npairs)
     the signed distance (m, negative: penetration); ``solver_iterations`` (N,) and
@@ -61,7 +62,8 @@ class Trajectory:
     @property
     def normal_force(self) -> np.ndarray | None:
         """``(N, npairs)`` the normal component of each pair's contact force (N), or None."""
-        return None if self.contact_force is None else np.einsum("kpi,pi->kp", self.contact_force, self.contact_normal)
+        return None if self.contact_force is None else np.einsum("kpi,kpi->kp", self.contact_force,
+                                                                     self.contact_normal)
 
     @property
     def friction_force(self) -> np.ndarray | None:
