@@ -25,7 +25,7 @@ from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
 from ..errors import RobodynWarning
 from . import _contact_step as CK
-from .simulate import _law_arrays, _kernel_law, _positive, _raise, unit_configuration
+from .simulate import law_arrays, compiled_law, positive_number, raise_at, unit_configuration
 
 _batch = batch_kernel(CK.rollout_at, CK.rollout_workspace)
 
@@ -75,10 +75,10 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     B = max(q0.shape[0], v0.shape[0])
     if q0.shape[0] not in (1, B) or v0.shape[0] not in (1, B):
         raise ValueError(f"q0, v0: {q0.shape[0]} and {v0.shape[0]} states do not broadcast")
-    duration, dt = _positive("duration", duration), _positive("dt", dt)
+    duration, dt = positive_number("duration", duration), positive_number("dt", dt)
     if dt > duration:
         raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
-    compiled = (0, None, None, None, None) if controller is None else _kernel_law(controller)
+    compiled = (0, None, None, None, None) if controller is None else compiled_law(controller)
     if compiled is None:
         raise ValueError(f"controller: rollout runs compiled control laws only (None, PDGravity, ComputedTorque, "
                          f"JointPD), got {type(controller).__name__}; use rd.simulate for other controllers")
@@ -107,7 +107,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     Fc, D, info = np.zeros((B, N, npairs, 3)), np.zeros((B, N, npairs, 4)), np.zeros((B, N, CS.INFO_SIZE))
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
     k = model.kernel
-    c, law, gains, breaks, coefs = _law_arrays(model, compiled)
+    c, law, gains, breaks, coefs = law_arrays(model, compiled)
     args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
             np.ascontiguousarray(model.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
@@ -118,7 +118,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
         b = int(bad[0])
         s, k = int(failed[b]), int(failed[b]) // every
         try:
-            _raise(model, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
+            raise_at(model, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
         except ValueError as e:
             raise ValueError(f"rollout {b}: {e}") from None
     t = np.arange(0, n + 1, every) * dt

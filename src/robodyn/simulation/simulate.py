@@ -76,7 +76,7 @@ def _vector(name: str, x, n: int) -> np.ndarray:
     return a
 
 
-def _positive(name: str, x) -> float:
+def positive_number(name: str, x) -> float:
     try:
         x = float(x)
     except (TypeError, ValueError):
@@ -166,7 +166,7 @@ class _Plant:
         status = K.stage(*args, q, np.ascontiguousarray(theta), np.ascontiguousarray(v), cmd, tau, thetadot, a,
                          self.ws, self.R)
         if status != OK:
-            _raise(self.model, status, t, q, v, cmd)
+            raise_at(self.model, status, t, q, v, cmd)
 
     def _constrained(self, args, t, q, theta, v, cmd, tau, thetadot, a):
         """The constrained stage: ``a`` of :func:`constrained_dynamics` under the clipped command
@@ -189,7 +189,7 @@ class _Plant:
         self.rate(q, theta, v, thetadot)
 
 
-def _raise(model, status, t, q, v, tau):
+def raise_at(model, status, t, q, v, tau):
     """The error of an ABA status at time ``t``."""
     try:
         bad = raise_for_status(model, status, {"q": q, "v": v, "tau (controller output)": tau},
@@ -254,7 +254,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     """
     q0 = _vector("q0", q0, model.nq)
     v0 = _vector("v0", v0, model.nv)
-    duration, dt = _positive("duration", duration), _positive("dt", dt)
+    duration, dt = positive_number("duration", duration), positive_number("dt", dt)
     if dt > duration:
         raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
     if contacts is not None:
@@ -300,7 +300,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Z[0] = law.z0
     compiled = None
     if integrator in INTEGRATORS and not law.stateful and plant.compiled:
-        compiled = (CONSTANT, None, None, None, None) if controller is None else _kernel_law(controller)
+        compiled = (CONSTANT, None, None, None, None) if controller is None else compiled_law(controller)
     touch = None
     if contacts is not None:
         touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar)
@@ -333,14 +333,14 @@ def unit_configuration(model, q0: np.ndarray, name: str = "q0") -> None:
         q0[..., k:k + size] /= n
 
 
-def _kernel_law(controller):
+def compiled_law(controller):
     """The compiled form of a built-in controller (``kernel_law``), with its model's arrays."""
     spec = getattr(controller, "kernel_law", None)
     spec = spec() if callable(spec) else None
     return None if spec is None else (spec[0], controller.model, *spec[1:])
 
 
-def _law_arrays(model, compiled):
+def law_arrays(model, compiled):
     """``(c, law, gains, breaks, coefs)``: the arguments of ``laws.law_torque`` for a compiled law."""
     law, cmodel, gains, breaks, coefs = compiled
     if law == CONSTANT:
@@ -356,7 +356,7 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
     when the progress bar is shown."""
     model = plant.model
     nv = model.nv
-    c, law, gains, breaks, coefs = _law_arrays(model, compiled)
+    c, law, gains, breaks, coefs = law_arrays(model, compiled)
     n = Q.shape[0] - 1
     method = K.RK4 if integrator == "rk4" else K.SEMI_IMPLICIT_EULER
     zero = np.zeros(nv)
@@ -367,7 +367,7 @@ def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
         status, s = K.run(*plant.args, c, law, gains, breaks, coefs, zero, method, Q[a].copy(), V[a].copy(), a, dt,
                           Q[a:b + 1], V[a:b + 1], A[a:b + 1], T[a:b + 1])
         if status != OK:
-            _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
+            raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
         bar.update(b)
 
 
@@ -397,7 +397,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
     geometry = (points, centers, radii, surf, settings)
     Q[0], V[0] = q0, v0
     if compiled is not None:
-        c, code, gains, breaks, coefs = _law_arrays(model, compiled)
+        c, code, gains, breaks, coefs = law_arrays(model, compiled)
         zero = np.zeros(nv)
         piece = max(1, n // 100) if bar.enabled else n
         for a in range(0, n, piece):
@@ -406,7 +406,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
                                V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
                                touch.info[a:b + 1], warm)
             if status != OK:
-                _raise(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
+                raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
             bar.update(b)
     else:
         ws = CK.workspace(model.nbodies, nv, len(names))
@@ -420,7 +420,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
             status = CK.step_kernel(*plant.args_at(t[s], q, v), *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
                                     touch.force[s], touch.geometry[s], warm, touch.info[s], ws)
             if status != OK:
-                _raise(model, status, t[s], q, v, cmd)
+                raise_at(model, status, t[s], q, v, cmd)
             if s < n:
                 Z[s + 1] = z + dt * zdot
             if s % every == 0:
