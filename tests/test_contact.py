@@ -411,6 +411,21 @@ def test_anymal_stands_on_its_urdf_foot_spheres():
     assert np.abs(traj.v[-1]).max() < 1e-3  # settling
 
 
+def test_animate_draws_the_surfaces_and_the_contact_points(tmp_path):
+    table = StaticBox((1.0, 1.0, 0.4), center=(0, 0, 0.2))
+    contacts = Contacts([Sphere("body", BALL_R)], surfaces=[Plane(), table])
+    traj = rd.simulate(BALL, [0.3, 0, 0.4 + BALL_R, 0, 0, 0, 1], [1.0, 0, 0, 0, 0, 0], 1.0, 1e-3, contacts=contacts)
+    data = plots.animate(BALL, traj.t, traj.q, tmp_path / "ball.gif", fps=10, contacts=contacts)
+    assert (tmp_path / "ball.gif").stat().st_size > 0 and data["axes"] == ("x", "z")
+    np.testing.assert_allclose(data["contact_points"][:, 0], traj.q[::100][:, [0, 2]], atol=1e-12)
+    model = solo12()
+    q0 = np.concatenate([[0, 0, 0.5], [0, 0, 0, 1], STANCE])
+    feet = Contacts([Sphere(f, 0.0175) for f in SOLO_FEET])
+    data = plots.animate(model, [0.0, 0.1], [q0, q0], tmp_path / "solo.gif", fps=10, contacts=feet)
+    assert data["contact_points"].shape == (2, 4, 3)
+    np.testing.assert_allclose(data["contact_points"][0], [rd.frame_pose(model, q0, f)[:3, 3] for f in SOLO_FEET])
+
+
 # --- MuJoCo on the same scenes ---------------------------------------------------------------
 
 def mujoco_box(angle_deg, mu, duration=1.0, dt=1e-3):

@@ -208,14 +208,42 @@ def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     return np.stack(pts, axis=1), segments
 
 
-def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -> dict:
+def _surface_outlines(surfaces, mid, half) -> list[np.ndarray]:
+    """World polylines (K, 3) outlining each contact surface near ``mid``: a square of side
+    ``2 half`` in a plane, the twelve edges of a static box (NaN-separated)."""
+    from .builder import rpy_to_matrix
+    from .contact.geometry import Plane
+
+    out = []
+    for s in surfaces:
+        if isinstance(s, Plane):
+            n = s.normal
+            p0 = mid + (s.height - n @ mid) * n
+            a = np.cross(n, np.eye(3)[int(np.argmin(np.abs(n)))])
+            a /= np.linalg.norm(a)
+            b = np.cross(n, a)
+            corners = ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))
+            out.append(np.array([p0 + half * (i * a + j * b) for i, j in corners]))
+        else:
+            R, h = rpy_to_matrix(s.rpy), 0.5 * s.size
+            c = [s.center + R @ (h * (2 * np.array(k) - 1)) for k in np.ndindex(2, 2, 2)]
+            edges = [(i, j) for i in range(8) for j in range(i + 1, 8) if bin(i ^ j).count("1") == 1]
+            out.append(np.vstack([np.vstack([c[i], c[j], np.full(3, np.nan)]) for i, j in edges]))
+    return out
+
+
+def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None, contacts=None) -> dict:
     """Stick-figure animation (GIF written by Pillow, matplotlib's image library) of the
     motion ``q`` (N, nq) at times ``t`` (N,), played in real time at ``fps`` frames per
     second. The axes are drawn once and the robot over them in each frame (blitting).
 
     ``planar``: draw in 2-D (None: when every point stays in a world coordinate plane).
-    Returns ``{"t", "points", "segments", "axes"}``: the frame times (F,), the drawn points
-    (F, P, 2 or 3), the segments, and the names of the drawn world axes.
+    ``contacts``: the :class:`robodyn.contact.Contacts` of the simulation: its surfaces are
+    drawn (planes as a square or a line, static boxes by their edges) and its contact spheres'
+    centres as red dots.
+    Returns ``{"t", "points", "segments", "axes", "contact_points"}``: the frame times (F,),
+    the drawn points (F, P, 2 or 3), the segments, the names of the drawn world axes, and the
+    drawn contact sphere centres (F, C, 2 or 3) or None.
     """
     t = np.asarray(t, dtype=float)
     q = np.atleast_2d(np.asarray(q, dtype=float))
@@ -227,6 +255,14 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
     nframes = max(1, min(t.shape[0], int(duration * fps) + 1))
     sel = np.unique(np.searchsorted(t, t[0] + np.arange(nframes) / fps).clip(0, t.shape[0] - 1))
     pts, segments = stick_points(model, q[sel])
+    touch = None
+    if contacts is not None:
+        from .algorithms.kinematics import forward_kinematics
+
+        (bodies, centers, _), _, _, _ = contacts.pack(model)
+        T = forward_kinematics(model, q[sel])
+        Tc = T[:, bodies]
+        touch = np.einsum("fcij,cj->fci", Tc[..., :3, :3], centers) + Tc[..., :3, 3]
     spread = pts.reshape(-1, 3).max(0) - pts.reshape(-1, 3).min(0)
     flat = np.flatnonzero(spread <= 1e-9 * max(spread.max(), 1e-12))
     if planar is None:
@@ -239,7 +275,9 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
     else:
         keep = [0, 1, 2]
         drawn = pts
-    data = dict(t=t[sel], points=drawn, segments=segments, axes=tuple(names[k] for k in keep))
+    touch_drawn = None if touch is None else touch[..., keep]
+    data = dict(t=t[sel], points=drawn, segments=segments, axes=tuple(names[k] for k in keep),
+                contact_points=touch_drawn)
     if path is None:
         return data
 
@@ -250,6 +288,16 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
     fig = Figure(figsize=(5, 5))
     FigureCanvasAgg(fig)
     lo, hi = drawn.reshape(-1, drawn.shape[-1]).min(0), drawn.reshape(-1, drawn.shape[-1]).max(0)
+    outlines = []
+    if contacts is not None:  # the surfaces near the robot, and the room to see them
+        world = pts.reshape(-1, 3)
+        w_mid, w_half = (world.min(0) + world.max(0)) / 2, max((world.max(0) - world.min(0)).max() / 2 * 1.1, 0.1)
+        outlines = [o[:, keep] for o in _surface_outlines(contacts.surfaces, w_mid, w_half)]
+        below = [o[np.isfinite(o[:, 0])] for o in outlines]
+        lo = np.minimum(lo, np.min([b.min(0) for b in below], axis=0)) if planar else lo
+        hi = np.maximum(hi, np.max([b.max(0) for b in below], axis=0)) if planar else hi
+        if not planar:
+            lo[2] = min(lo[2], min(b[:, 2].min() for b in below))
     mid, half = (lo + hi) / 2, max((hi - lo).max() / 2 * 1.1, 0.1)
     if planar:
         fig.subplots_adjust(left=0.16, bottom=0.11, right=0.96, top=0.92)
@@ -273,7 +321,12 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
         xyz[gap] = np.nan
         return xyz
 
+    for o in outlines:
+        ax.plot(*o.T, color="0.5", lw=1)
     line, = ax.plot(*polyline(0).T, "o-", color="C0", lw=3, ms=4, animated=True)
+    dots = None
+    if touch_drawn is not None:
+        dots, = ax.plot(*touch_drawn[0].T, "o", color="C3", ms=5, animated=True)
     title = ax.set_title("", animated=True)
     # the axes do not change: draw them once, then only the robot and the time (blitting)
     canvas = fig.canvas
@@ -287,6 +340,11 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None) -
         if not planar:
             line.set_3d_properties(xyz[:, 2])
         title.set_text(f"{model.name}  t = {data['t'][f]:.2f} s")
+        if dots is not None:
+            dots.set_data(touch_drawn[f, :, 0], touch_drawn[f, :, 1])
+            if not planar:
+                dots.set_3d_properties(touch_drawn[f, :, 2])
+            ax.draw_artist(dots)
         ax.draw_artist(line)
         ax.draw_artist(title)
         w, h = canvas.get_width_height()

@@ -246,7 +246,7 @@ def cmd_simulate(args) -> int:
         save(lambda path: plot_simulation(traj, path), args.plot, "--plot")
         print(f"  wrote {written(args.plot)}")
     if args.gif:
-        save(lambda path: animate(model, traj.t, traj.q, path, fps=args.fps), args.gif, "--gif")
+        save(lambda path: animate(model, traj.t, traj.q, path, fps=args.fps, contacts=contacts), args.gif, "--gif")
         print(f"  wrote {written(args.gif)}")
     if args.contact_plot:
         save(lambda path: plot_contacts(traj, path), args.contact_plot, "--contact-plot")
