@@ -518,3 +518,21 @@ def test_a_solve_that_does_not_converge_is_reported():
         warnings.simplefilter("error")
         traj = rd.simulate(BOX, q0, np.zeros(6), 0.5, 1e-3, contacts=Contacts([Box("body", SIZE)]))
     assert traj.solver_residual.max() < 1e-6
+
+
+def test_contact_scenes_example(capsys):
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+    import contact_scenes as ex
+
+    _, _, ball = ex.bouncing_ball(duration=2.0)
+    ratios = [float(x) for x in capsys.readouterr().out.split("=")[1].strip(" []\n").replace("np.float64(", "")
+              .replace(")", "").split(",")]
+    assert len(ratios) >= 3 and np.allclose(ratios[:3], 1.0, atol=0.01)
+    for degrees, expected in ((35.0, G * (np.sin(np.radians(35)) - 0.5 * np.cos(np.radians(35)))), (20.0, 0.0)):
+        _, _, traj = ex.box_on_incline(degrees)
+        accel = float(capsys.readouterr().out.split("acceleration ")[1].split(" m/s^2")[0])
+        assert accel == pytest.approx(expected, rel=0.01, abs=1e-5)
+    model, _, traj = ex.hopper()
+    # a turning foot may sink by the second-order motion of a step (here about 1e-8 m); the body never falls
+    assert traj.contact_distance.min() > -1e-6 and traj.q[:, 1].min() > 0.3
+    assert "3 touchdowns" in capsys.readouterr().out

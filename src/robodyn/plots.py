@@ -197,10 +197,10 @@ def stick_points(model, q) -> tuple[np.ndarray, list[tuple[int, int]]]:
     nb = model.nbodies
     frames = [k for k in range(len(model.frame_names)) if model.frame_body[k] >= 0]
     pts = [np.zeros((T.shape[0], 3)), *(T[:, i, :3, 3] for i in range(nb))]
-    from .joints import FREE
+    from .joints import FREE, PLANAR
 
-    segments = [(0 if model.parent[i] < 0 else model.parent[i] + 1, i + 1) for i in range(nb)
-                if not (model.parent[i] < 0 and model.joint_type[i] == FREE)]  # a floating base flies free
+    segments = [(0 if model.parent[i] < 0 else model.parent[i] + 1, i + 1) for i in range(nb)  # a floating
+                if not (model.parent[i] < 0 and model.joint_type[i] in (FREE, PLANAR))]  # base flies free
     for k in frames:
         b = model.frame_body[k]
         pts.append(T[:, b, :3, 3] + T[:, b, :3, :3] @ model.frame_p[k])
