@@ -273,10 +273,12 @@ def _keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
 def rollout_at(args, b, rws):
     """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
     ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
-    ``args[-1][b]``."""
-    (ints, body, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, law, gains, breaks, coefs, tau_cmd,
+    ``args[-1][b]``. ``bodies`` (B or 1, nb, BODY_COLUMNS): the body table of each rollout
+    (its inertial parameters), or one for all."""
+    (ints, bodies, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, law, gains, breaks, coefs, tau_cmd,
      points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed) = args
     c = (c0, c1, c2, c3, c4, c5)  # the law's model, flat in ``args`` (a parallel loop takes no nested tuple)
+    body = bodies[b if bodies.shape[0] > 1 else 0]
     warm, Qs, Vs, As, Ts, Fs, Ds, Is = rws[5], rws[6], rws[7], rws[8], rws[9], rws[10], rws[11], rws[12]
     for p in range(warm.shape[0]):
         for r in range(3):

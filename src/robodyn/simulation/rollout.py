@@ -64,17 +64,47 @@ def _states(name, x, n):
     return a.reshape(-1, n)
 
 
-def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, contacts=None, every: int = 1) -> Rollouts:
+def _bodies(model, inertia, B: int) -> np.ndarray:
+    """The body table of each rollout (B or 1, nb, BODY_COLUMNS) with its inertial parameters."""
+    from ..layout import INERTIA, INERTIA_END
+    from ..model import consistent_inertial_parameters
+
+    body = model.kernel.body
+    if inertia is None:
+        return body[None]
+    try:
+        theta = np.array(inertia, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"inertia: expected an array of numbers, got {type(inertia).__name__}") from None
+    if theta.ndim != 3 or theta.shape[0] not in (1, B) or theta.shape[1:] != (model.nbodies, 10):
+        raise ValueError(f"inertia: expected shape ({B}, {model.nbodies}, 10), got {theta.shape}")
+    good = consistent_inertial_parameters(theta.reshape(-1, 10)).reshape(theta.shape[:2])
+    if not good.all():
+        b, i = (int(x) for x in np.argwhere(~good)[0])
+        raise ValueError(f"inertia: rollout {b}, body {i} ({model.link_names[i]!r}): {theta[b, i].tolist()} are not "
+                         f"the inertial parameters of a rigid body (mass >= 0, inertia about the centre of mass "
+                         f"positive semi-definite with the triangle inequality)")
+    bodies = np.repeat(body[None], theta.shape[0], axis=0)
+    bodies[:, :, INERTIA:INERTIA_END] = theta
+    return bodies
+
+
+def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, contacts=None, every: int = 1,
+            inertia=None) -> Rollouts:
     """``B`` simulations of ``duration`` seconds with steps of ``dt`` from the initial states
     ``q0`` (B, nq) and ``v0`` (B, nv) (one of them may be a single state), in parallel (see
     the module docstring), keeping every ``every``-th sample (times ``k every dt``; the steps'
     accelerations, torques and contact forces at those samples), so that long batches fit in
-    memory. Raises for the first rollout that fails (naming it and the time); warns, as
-    :func:`robodyn.simulate`, when contact solves stopped above ``warn_above``."""
+    memory. ``inertia``: None, or (B, nbodies, 10) the inertial parameters of each rollout's
+    robot (``Model.inertia``'s layout; checked as a model's are): Monte Carlo over masses and
+    inertias, the controller keeping its own model. Raises for the first rollout that fails
+    (naming it and the time); warns, as :func:`robodyn.simulate`, when contact solves stopped
+    above ``warn_above``."""
     q0, v0 = _states("q0", q0, model.nq), _states("v0", v0, model.nv)
-    B = max(q0.shape[0], v0.shape[0])
+    B = max(q0.shape[0], v0.shape[0], np.shape(inertia)[0] if np.ndim(inertia) == 3 else 1)
     if q0.shape[0] not in (1, B) or v0.shape[0] not in (1, B):
         raise ValueError(f"q0, v0: {q0.shape[0]} and {v0.shape[0]} states do not broadcast")
+    bodies = _bodies(model, inertia, B)
     duration, dt = positive_number("duration", duration), positive_number("dt", dt)
     if dt > duration:
         raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")
@@ -108,7 +138,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
     k = model.kernel
     c, law, gains, breaks, coefs = law_arrays(model, compiled)
-    args = (k.ints, k.body, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
+    args = (k.ints, bodies, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
             np.ascontiguousarray(model.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
             Q, V, A, T, Fc, D, info, failed)
