@@ -24,7 +24,7 @@ from robodyn import joints as J
 from robodyn import plots
 from robodyn.control import JointPD, laws
 from robodyn.algorithms.constrained import frame_kinematics
-from robodyn.contact import Box, Capsule, Contacts, Plane, Point, Sphere, StaticBox, shapes_from_urdf
+from robodyn.contact import BodySphere, Box, Capsule, Contacts, Plane, Point, Sphere, StaticBox, shapes_from_urdf
 from robodyn.random import random_model, random_state
 
 from conftest import example_robot_data_dir
@@ -218,6 +218,39 @@ def test_static_boxes_are_tables_walls_and_steps():
     traj = rd.simulate(BALL, [0, 0, 0.15, 0, 0, 0, 1], np.zeros(6), 1.0, 1e-3,
                        contacts=Contacts([Sphere("body", BALL_R)], surfaces=[step], max_correction=0.3))
     assert np.abs(traj.v[:, 2]).max() <= 0.3 + 1e-9 and traj.q[-1, 2] == pytest.approx(0.2 + BALL_R, abs=1e-6)
+
+
+def two_balls():
+    b = rd.ModelBuilder(gravity=(0, 0, -G))
+    b.add_link("world")
+    for n in ("a", "b"):
+        b.add_link(n, mass=1.0, inertia=0.4 * BALL_R ** 2 * np.eye(3))
+        b.add_joint(n + "_free", "free", "world", n)
+    return b.build()
+
+
+def test_spheres_on_bodies_stack_and_collide():
+    model = two_balls()
+    contacts = Contacts([Sphere("a", BALL_R), Sphere("b", BALL_R)],
+                        surfaces=[Plane(friction=0.5), BodySphere("b", BALL_R, friction=0.5)])
+    assert contacts.pack(model)[3] == ("a:sphere@ground", "a:sphere@b:sphere", "b:sphere@ground",
+                                       "b:sphere@b:sphere")
+    q0 = np.array([0, 0, 0.6, 0, 0, 0, 1, 0, 0, BALL_R, 0, 0, 0, 1.0])
+    traj = rd.simulate(model, q0, np.zeros(12), 1.0, 1e-3, contacts=contacts)
+    assert traj.q[-1, 2] == pytest.approx(3 * BALL_R, abs=1e-9) and traj.q[-1, 9] == pytest.approx(BALL_R, abs=1e-9)
+    np.testing.assert_allclose(traj.contact_force[-1, :3], [[0, 0, 0], [0, 0, G], [0, 0, 2 * G]], atol=1e-6)
+    assert np.all(np.isinf(traj.contact_distance[:, 3]))  # a body never touches itself
+    # head-on, weightless, restitution e: equal masses leave with v (1 - e) / 2 and v (1 + e) / 2
+    e, v = 0.6, 2.0
+    weightless = model.replace(gravity=np.zeros(3))
+    contacts = Contacts([Sphere("a", BALL_R)], surfaces=[BodySphere("b", BALL_R, friction=0.0, restitution=e)])
+    q0 = np.array([-0.5, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 1.0])
+    v0 = np.zeros(12)
+    v0[0] = v
+    traj = rd.simulate(weightless, q0, v0, 0.5, 1e-3, contacts=contacts)
+    np.testing.assert_allclose([traj.v[-1, 0], traj.v[-1, 6]], [v * (1 - e) / 2, v * (1 + e) / 2], rtol=1e-6)
+    momentum = traj.v[:, 0] + traj.v[:, 6]
+    np.testing.assert_allclose(momentum, v, rtol=1e-9)  # the pair's forces are equal and opposite
 
 
 # --- identities with the other algorithms ---------------------------------------------------
@@ -477,11 +510,13 @@ def test_box_on_a_plane_agrees_with_mujoco():
     (lambda: StaticBox((1.0, -1.0, 1.0)), "StaticBox.size: every edge must be > 0"),
     (lambda: StaticBox((1.0, 1.0, 1.0), center=(0, np.inf, 0)), "StaticBox.center: contains NaN or Inf"),
     (lambda: StaticBox((1.0, 1.0, 1.0), friction=-1), "StaticBox.friction: must be >= 0"),
+    (lambda: BodySphere("body", 0.0), "BodySphere.radius: must be > 0"),
+    (lambda: BodySphere("body", 0.1, restitution=2), "BodySphere.restitution: must lie in"),
     (lambda: Capsule("body", -0.1, 0.2), "radius: must be > 0"),
     (lambda: Sphere(1.5, 0.1), "expected a link or frame name"),
     (lambda: Contacts([]), "at least one shape"),
     (lambda: Contacts(["body"]), r"shapes\[0\]: expected a Sphere"),
-    (lambda: Contacts([Sphere("body", 0.1)], surfaces=["ground"]), r"surfaces\[0\]: expected a Plane or a StaticBox"),
+    (lambda: Contacts([Sphere("body", 0.1)], surfaces=["ground"]), r"surfaces\[0\]: expected a Plane, StaticBox or BodySphere"),
     (lambda: Contacts([Sphere("body", 0.1)], max_iterations=0), "max_iterations"),
     (lambda: Contacts([Sphere("body", 0.1)], tolerance=-1), "tolerance: must be > 0"),
     (lambda: Contacts([Sphere("body", 0.1)], stabilization=2), "stabilization: must lie in"),

@@ -212,7 +212,7 @@ def _surface_outlines(surfaces, mid, half) -> list[np.ndarray]:
     """World polylines (K, 3) outlining each contact surface near ``mid``: a square of side
     ``2 half`` in a plane, the twelve edges of a static box (NaN-separated)."""
     from .builder import rpy_to_matrix
-    from .contact.geometry import Plane
+    from .contact.geometry import Plane, StaticBox
 
     out = []
     for s in surfaces:
@@ -224,7 +224,7 @@ def _surface_outlines(surfaces, mid, half) -> list[np.ndarray]:
             b = np.cross(n, a)
             corners = ((-1, -1), (1, -1), (1, 1), (-1, 1), (-1, -1))
             out.append(np.array([p0 + half * (i * a + j * b) for i, j in corners]))
-        else:
+        elif isinstance(s, StaticBox):  # (a sphere on a body moves: not drawn)
             R, h = rpy_to_matrix(s.rpy), 0.5 * s.size
             c = [s.center + R @ (h * (2 * np.array(k) - 1)) for k in np.ndindex(2, 2, 2)]
             edges = [(i, j) for i in range(8) for j in range(i + 1, 8) if bin(i ^ j).count("1") == 1]
@@ -293,10 +293,10 @@ def animate(model, t, q, path=None, fps: int = 20, planar: bool | None = None, c
         world = pts.reshape(-1, 3)
         w_mid, w_half = (world.min(0) + world.max(0)) / 2, max((world.max(0) - world.min(0)).max() / 2 * 1.1, 0.1)
         outlines = [o[:, keep] for o in _surface_outlines(contacts.surfaces, w_mid, w_half)]
-        below = [o[np.isfinite(o[:, 0])] for o in outlines]
+        below = [o[np.isfinite(o[:, 0])] for o in outlines] or [lo[None], hi[None]]
         lo = np.minimum(lo, np.min([b.min(0) for b in below], axis=0)) if planar else lo
         hi = np.maximum(hi, np.max([b.max(0) for b in below], axis=0)) if planar else hi
-        if not planar:
+        if not planar and outlines:
             lo[2] = min(lo[2], min(b[:, 2].min() for b in below))
     mid, half = (lo + hi) / 2, max((hi - lo).max() / 2 * 1.1, 0.1)
     if planar:

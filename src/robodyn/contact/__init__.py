@@ -11,6 +11,6 @@ solver are described in :mod:`robodyn.contact.solver`; the shapes in
 :mod:`robodyn.contact.geometry`.
 """
 
-from .geometry import Box, Capsule, Contacts, Plane, Point, Sphere, StaticBox, shapes_from_urdf
+from .geometry import BodySphere, Box, Capsule, Contacts, Plane, Point, Sphere, StaticBox, shapes_from_urdf
 
-__all__ = ["Contacts", "Sphere", "Point", "Box", "Capsule", "Plane", "StaticBox", "shapes_from_urdf"]
+__all__ = ["Contacts", "Sphere", "Point", "Box", "Capsule", "Plane", "StaticBox", "BodySphere", "shapes_from_urdf"]

@@ -209,13 +209,48 @@ class StaticBox:
         object.__setattr__(self, "restitution", e)
 
 
-def _surface_row(s) -> np.ndarray:
-    """The row of ``solver``'s surface table for a :class:`Plane` or :class:`StaticBox`."""
+@dataclass(frozen=True, eq=False)
+class BodySphere:
+    """A sphere of ``radius`` centred at ``center`` in the coordinates of ``body`` (a link or
+    frame of the same model), as a surface the robot's shapes touch: an object held or
+    pushed (a ball on a free joint), a part of the robot another part may hit. ``friction``,
+    ``restitution`` as :class:`Plane`'s. The pair's force acts on the shape's body; the
+    sphere's body takes the opposite force. A shape on the sphere's own body is never paired
+    with it."""
+
+    body: str | int
+    radius: float
+    center: np.ndarray = (0.0, 0.0, 0.0)
+    friction: float = 1.0
+    restitution: float = 0.0
+    name: str | None = None
+
+    def __post_init__(self):
+        object.__setattr__(self, "body", _body("BodySphere.body", self.body))
+        object.__setattr__(self, "radius", _positive("BodySphere.radius", self.radius))
+        object.__setattr__(self, "center", _finite("BodySphere.center", self.center, (3,)))
+        object.__setattr__(self, "friction", _positive("BodySphere.friction", self.friction, zero=True))
+        e = _positive("BodySphere.restitution", self.restitution, zero=True)
+        if e > 1:
+            raise ValueError(f"BodySphere.restitution: must lie in [0, 1], got {e}")
+        object.__setattr__(self, "restitution", e)
+        if self.name is None:
+            object.__setattr__(self, "name", f"{self.body}:sphere")
+
+
+def _surface_row(s, model) -> np.ndarray:
+    """The row of ``solver``'s surface table for a :class:`Plane`, :class:`StaticBox` or
+    :class:`BodySphere` (on ``model``)."""
+    from ..algorithms.jacobian import moving_frame
     from . import solver as S
 
     row = np.zeros(S.SURFACE_COLUMNS)
     row[S.FRICTION], row[S.RESTITUTION] = s.friction, s.restitution
-    if isinstance(s, Plane):
+    if isinstance(s, BodySphere):
+        b, R, p = moving_frame(model, s.body)
+        row[S.KIND], row[S.RADIUS], row[S.BODY] = S.BODY_SPHERE, s.radius, b
+        row[S.CENTER:S.CENTER + 3] = p + R @ s.center
+    elif isinstance(s, Plane):
         row[S.KIND] = S.PLANE
         row[S.NORMAL:S.NORMAL + 3], row[S.HEIGHT] = s.normal, s.height
     else:
@@ -227,7 +262,7 @@ def _surface_row(s) -> np.ndarray:
 
 
 SHAPES = (Sphere, Point, Box, Capsule)
-SURFACES = (Plane, StaticBox)
+SURFACES = (Plane, StaticBox, BodySphere)
 
 
 @dataclass(frozen=True, eq=False)
@@ -269,7 +304,7 @@ class Contacts:
         surfaces = tuple(self.surfaces) if isinstance(self.surfaces, (list, tuple)) else (self.surfaces,)
         for k, s in enumerate(surfaces):
             if not isinstance(s, SURFACES):
-                raise ValueError(f"Contacts.surfaces[{k}]: expected a Plane or a StaticBox, got {s!r}")
+                raise ValueError(f"Contacts.surfaces[{k}]: expected a Plane, StaticBox or BodySphere, got {s!r}")
         if not shapes or not surfaces:
             raise ValueError("Contacts: needs at least one shape and one surface")
         object.__setattr__(self, "shapes", shapes)
@@ -306,7 +341,13 @@ class Contacts:
                 centers.append(p + R @ c)
                 radii.append(r)
                 labels.append(base + lab)
-        surf = np.array([_surface_row(s) for s in self.surfaces])
+        rows = []
+        for k, s in enumerate(self.surfaces):
+            try:
+                rows.append(_surface_row(s, model))
+            except (KeyError, ValueError, IndexError) as e:
+                raise ValueError(f"Contacts.surfaces[{k}]: {e}") from None
+        surf = np.array(rows)
         settings = np.array([self.max_iterations, self.tolerance, self.stabilization, self.max_correction,
                              self.bounce_speed, self.margin], dtype=float)
         names = tuple(f"{lab}@{s.name}" for lab in labels for s in self.surfaces)

@@ -57,10 +57,12 @@ POLISH_AFTER, POLISH_ROUNDS = 100, 40
 
 # ``surfaces`` table columns (one row per surface, see ``geometry.Contacts.pack``): the kind,
 # Coulomb's mu and Newton's e, then a plane's unit normal and height (``n . x <= height`` is
-# solid) or a box's centre, rotation (row-major, box to world) and half edges
+# solid), a box's centre, rotation (row-major, box to world) and half edges, or a sphere
+# moving with a body: its centre in the body's frame, its radius and the body's index
 KIND, FRICTION, RESTITUTION, NORMAL, HEIGHT, CENTER, ROTATION, HALF = 0, 1, 2, 3, 6, 3, 7, 16
+RADIUS, BODY = 6, 7
 SURFACE_COLUMNS = 19
-PLANE, BOX = 0, 1
+PLANE, BOX, BODY_SPHERE = 0, 1, 2
 
 # ``info`` entries of a step: the sweeps used, the last sweep's residual, the contacts solved
 ITERATIONS, RESIDUAL, ACTIVE = range(3)
@@ -68,11 +70,27 @@ INFO_SIZE = 3
 
 
 @inline
-def surface_distance(row, x, radius, n):
+def surface_distance(row, x, radius, n, oR, op, y):
     """Signed distance (m) from the sphere of centre ``x`` (world) and ``radius`` to the solid
     surface of the table row ``row``, and the surface's outward unit normal at the nearest
     point into ``n`` (3,). A box: the nearest point of its surface from the centre taken in
-    the box's frame (clamped to the half edges outside, the nearest face inside)."""
+    the box's frame (clamped to the half edges outside, the nearest face inside). A sphere on
+    a body (world placements ``oR``, ``op``): along the line of the centres, its surface
+    point facing ``x`` into ``y`` (3,)."""
+    if row[KIND] == BODY_SPHERE:
+        b = int(row[BODY])
+        c0, c1, c2 = row[CENTER], row[CENTER + 1], row[CENTER + 2]
+        for r in range(3):
+            y[r] = op[b, r] + oR[b, r, 0] * c0 + oR[b, r, 1] * c1 + oR[b, r, 2] * c2
+        d0, d1, d2 = x[0] - y[0], x[1] - y[1], x[2] - y[2]
+        d = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if d > 0.0:
+            n[0], n[1], n[2] = d0 / d, d1 / d, d2 / d
+        else:  # concentric: any direction
+            n[0], n[1], n[2] = 0.0, 0.0, 1.0
+        for r in range(3):
+            y[r] += row[RADIUS] * n[r]
+        return d - row[RADIUS] - radius
     if row[KIND] == PLANE:
         for r in range(3):
             n[r] = row[NORMAL + r]
@@ -164,13 +182,10 @@ def contact_frame(n, F):
 
 
 @inline
-def point_rows(ints, oS, b, x, F, rows):
-    """``rows`` (3, nv): the frame ``F``'s rows times the Jacobian of the velocity of the
-    world point ``x`` moving with body ``b``: column ``k`` of that Jacobian is
+def point_rows(ints, oS, b, x, F, rows, sign):
+    """``rows`` (3, nv) ``+= sign`` times the frame ``F``'s rows times the Jacobian of the
+    velocity of the world point ``x`` moving with body ``b``: column ``k`` of that Jacobian is
     ``oS_k[:3] + oS_k[3:] x x`` (``oS`` the world-frame motion subspace columns)."""
-    for r in range(3):
-        for k in range(rows.shape[1]):
-            rows[r, k] = 0.0
     j = b
     while j >= 0:
         for k in range(ints[j, IV], ints[j, IV] + ints[j, NDOF]):
@@ -179,7 +194,7 @@ def point_rows(ints, oS, b, x, F, rows):
             c1 = oS[k, 1] + w2 * x[0] - w0 * x[2]
             c2 = oS[k, 2] + w0 * x[1] - w1 * x[0]
             for r in range(3):
-                rows[r, k] = F[r, 0] * c0 + F[r, 1] * c1 + F[r, 2] * c2
+                rows[r, k] += sign * (F[r, 0] * c0 + F[r, 1] * c1 + F[r, 2] * c2)
         j = ints[j, PARENT]
 
 

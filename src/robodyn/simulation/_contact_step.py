@@ -19,10 +19,10 @@ from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
-from ..contact.solver import (ACTIVE, BOUNCE_SPEED, FRICTION, INFO_SIZE, ITERATIONS, MARGIN, MAX_CORRECTION,
-                              MAX_ITERATIONS, RESIDUAL, RESTITUTION, surface_distance,
-                              STABILIZATION, TOLERANCE, backward, cholesky, contact_frame, delassus, forward, solve,
-                              point_rows)
+from ..contact.solver import (ACTIVE, BODY, BODY_SPHERE, BOUNCE_SPEED, FRICTION, INFO_SIZE, ITERATIONS, KIND, MARGIN,
+                              MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL, RESTITUTION, STABILIZATION, TOLERANCE,
+                              backward, cholesky, contact_frame, delassus, forward, point_rows, solve,
+                              surface_distance)
 from ..control.laws import law_torque
 from ..joints import FREE, PLANAR
 from ..layout import IV, JTYPE
@@ -37,7 +37,7 @@ def workspace(nb, nv, npairs):
             np.zeros(nv), np.empty((m3, nv)), np.empty((nv, m3)), np.empty((m3, m3)), np.empty(m3),
             np.empty(npairs), np.empty(npairs), np.empty(m3), np.empty((npairs, 3, 3)),
             np.empty(npairs, np.int64), np.empty((3, 3)), np.empty(nv), np.empty(3),
-            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))), np.empty(3))
+            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))), np.empty(3), np.empty(3))
 
 
 @inline
@@ -104,7 +104,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
     geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the solver's ``info`` (sweeps, residual, active contacts;
     converged when the residual is at most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous
     step's impulses in the contact frames (read and written). Returns a status."""
-    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws, nrm = ws
+    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws, nrm, ysurf = ws
     nv = v.shape[0]
     for k in range(nv):
         tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
@@ -132,7 +132,15 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             x[r] = op[b, r] + oR[b, r, 0] * centers[p, 0] + oR[b, r, 1] * centers[p, 1] + oR[b, r, 2] * centers[p, 2]
         for s in range(ns):
             pair = p * ns + s
-            phi = surface_distance(surf[s], x, rad, nrm)
+            other = int(surf[s, BODY]) if surf[s, KIND] == BODY_SPHERE else -1
+            if other == b:  # a body does not touch itself
+                geom[pair, 0] = np.inf
+                for r in range(3):
+                    geom[pair, 1 + r] = 0.0
+                    force[pair, r] = 0.0
+                    warm[pair, r] = 0.0
+                continue
+            phi = surface_distance(surf[s], x, rad, nrm, oR, op, ysurf)
             geom[pair, 0] = phi
             for r in range(3):
                 geom[pair, 1 + r] = nrm[r]
@@ -141,7 +149,12 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             contact_frame(nrm, F)
             for r in range(3):  # the sphere's point nearest the surface
                 tmp[r] = x[r] - rad * F[0, r]
-            point_rows(ints, oS, b, tmp[:3], F, rows)
+            for r in range(3):
+                for k in range(nv):
+                    rows[r, k] = 0.0
+            point_rows(ints, oS, b, tmp[:3], F, rows, 1.0)
+            if other >= 0:  # the velocity relative to the other body's surface point
+                point_rows(ints, oS, other, ysurf, F, rows, -1.0)
             u_free, u_before = _dot(rows[0], vf), _dot(rows[0], v)
             if phi >= settings[MARGIN] - dt * min(u_free, 0.0):
                 for r in range(3):
