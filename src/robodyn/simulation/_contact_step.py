@@ -101,9 +101,10 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
          tau, a, q1, v1, force, geom, warm, info, ws):
     """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
     state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
-    geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the solver's ``info`` (sweeps, residual, active contacts;
-    converged when the residual is at most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous
-    step's impulses in the contact frames (read and written). Returns a status."""
+    geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the
+    solver's ``info`` (sweeps, residual, active contacts; converged when the residual is at
+    most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous step's impulses in the
+    contact frames (read and written). Returns a status."""
     cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws, nrm, ysurf = ws
     nv = v.shape[0]
     for k in range(nv):
