@@ -77,6 +77,7 @@ def _vector(name: str, x, n: int) -> np.ndarray:
 
 
 def positive_number(name: str, x) -> float:
+    """``x`` as a finite float > 0, or a ``ValueError`` naming ``name``."""
     try:
         x = float(x)
     except (TypeError, ValueError):
