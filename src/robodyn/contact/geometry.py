@@ -17,7 +17,8 @@ World surfaces: :class:`Plane` ``(normal, height, friction, restitution)``, the 
 ``normal . x <= height`` being solid (the ground is ``Plane()``; an incline, a wall are
 planes with other normals), and :class:`StaticBox` ``(size, center, rpy, friction,
 restitution)``, an obstacle (a table, a step) that spheres touch at the nearest point of its
-surface. Friction (Coulomb coefficient ``mu``, isotropic) and
+surface, and :class:`BodySphere` ``(body, radius, center, friction, restitution)``, a sphere
+moving with a body of the model (contact between bodies). Friction (Coulomb coefficient ``mu``, isotropic) and
 restitution (Newton's coefficient ``e``) belong to the surface.
 
 :class:`Contacts` gathers the shapes, the surfaces and the solver's settings; it is what
@@ -52,6 +53,25 @@ def _positive(name: str, x, zero: bool = False) -> float:
     if x < 0 or (x == 0 and not zero):
         raise ValueError(f"{name}: must be {'>= 0' if zero else '> 0'}, got {x}")
     return x
+
+
+def _edges(name: str, size) -> np.ndarray:
+    """A box's three edge lengths, each > 0."""
+    size = _finite(name, size, (3,))
+    if np.any(size <= 0):
+        raise ValueError(f"{name}: every edge must be > 0, got {size.tolist()}")
+    return size
+
+
+def _set_coefficients(surface) -> None:
+    """Check and set a surface's ``friction`` (Coulomb's ``mu >= 0``) and ``restitution``
+    (Newton's ``0 <= e <= 1``)."""
+    cls = type(surface).__name__
+    object.__setattr__(surface, "friction", _positive(f"{cls}.friction", surface.friction, zero=True))
+    e = _positive(f"{cls}.restitution", surface.restitution, zero=True)
+    if e > 1:
+        raise ValueError(f"{cls}.restitution: must lie in [0, 1], got {e}")
+    object.__setattr__(surface, "restitution", e)
 
 
 def _body(name: str, body):
@@ -95,10 +115,6 @@ class Point:
         return [(self.point, 0.0)], [""]
 
 
-def _placement(center, rpy):
-    return center, rpy_to_matrix(rpy)
-
-
 @dataclass(frozen=True, eq=False)
 class Box:
     """A box of edge lengths ``size`` (3,) (m), centred at ``center`` and rotated by ``rpy``
@@ -114,13 +130,10 @@ class Box:
         object.__setattr__(self, "body", _body("Box.body", self.body))
         object.__setattr__(self, "center", _finite("Box.center", self.center, (3,)))
         object.__setattr__(self, "rpy", _finite("Box.rpy", self.rpy, (3,)))
-        size = _finite("Box.size", self.size, (3,))
-        if np.any(size <= 0):
-            raise ValueError(f"Box.size: every edge must be > 0, got {size.tolist()}")
-        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "size", _edges("Box.size", self.size))
 
     def spheres(self):
-        c, R = _placement(self.center, self.rpy)
+        c, R = self.center, rpy_to_matrix(self.rpy)
         signs = [(sx, sy, sz) for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
         corners = [c + R @ (0.5 * self.size * np.array(s)) for s in signs]
         labels = ["[" + "".join("+" if v > 0 else "-" for v in s) + "]" for s in signs]
@@ -148,7 +161,7 @@ class Capsule:
         object.__setattr__(self, "length", _positive("Capsule.length", self.length, zero=True))
 
     def spheres(self):
-        c, R = _placement(self.center, self.rpy)
+        c, R = self.center, rpy_to_matrix(self.rpy)
         h = 0.5 * self.length * R[:, 2]
         return [(c - h, self.radius), (c + h, self.radius)], ["[-]", "[+]"]
 
@@ -174,11 +187,7 @@ class Plane:
         n.flags.writeable = False
         object.__setattr__(self, "normal", n)
         object.__setattr__(self, "height", float(_finite("Plane.height", self.height, ())))
-        object.__setattr__(self, "friction", _positive("Plane.friction", self.friction, zero=True))
-        e = _positive("Plane.restitution", self.restitution, zero=True)
-        if e > 1:
-            raise ValueError(f"Plane.restitution: must lie in [0, 1], got {e}")
-        object.__setattr__(self, "restitution", e)
+        _set_coefficients(self)
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,17 +205,10 @@ class StaticBox:
     name: str = "box"
 
     def __post_init__(self):
-        size = _finite("StaticBox.size", self.size, (3,))
-        if np.any(size <= 0):
-            raise ValueError(f"StaticBox.size: every edge must be > 0, got {size.tolist()}")
-        object.__setattr__(self, "size", size)
+        object.__setattr__(self, "size", _edges("StaticBox.size", self.size))
         object.__setattr__(self, "center", _finite("StaticBox.center", self.center, (3,)))
         object.__setattr__(self, "rpy", _finite("StaticBox.rpy", self.rpy, (3,)))
-        object.__setattr__(self, "friction", _positive("StaticBox.friction", self.friction, zero=True))
-        e = _positive("StaticBox.restitution", self.restitution, zero=True)
-        if e > 1:
-            raise ValueError(f"StaticBox.restitution: must lie in [0, 1], got {e}")
-        object.__setattr__(self, "restitution", e)
+        _set_coefficients(self)
 
 
 @dataclass(frozen=True, eq=False)
@@ -229,11 +231,7 @@ class BodySphere:
         object.__setattr__(self, "body", _body("BodySphere.body", self.body))
         object.__setattr__(self, "radius", _positive("BodySphere.radius", self.radius))
         object.__setattr__(self, "center", _finite("BodySphere.center", self.center, (3,)))
-        object.__setattr__(self, "friction", _positive("BodySphere.friction", self.friction, zero=True))
-        e = _positive("BodySphere.restitution", self.restitution, zero=True)
-        if e > 1:
-            raise ValueError(f"BodySphere.restitution: must lie in [0, 1], got {e}")
-        object.__setattr__(self, "restitution", e)
+        _set_coefficients(self)
         if self.name is None:
             object.__setattr__(self, "name", f"{self.body}:sphere")
 
@@ -270,13 +268,13 @@ class Contacts:
     """Shapes on the robot, static surfaces, and the settings of the contact solver.
 
     ``shapes``: :class:`Sphere`, :class:`Point`, :class:`Box`, :class:`Capsule`;
-    ``surfaces``: :class:`Plane`, :class:`StaticBox` (default: the ground ``z = 0`` with
-    ``mu = 1``).
+    ``surfaces``: :class:`Plane`, :class:`StaticBox`, :class:`BodySphere` (default: the ground
+    ``z = 0`` with ``mu = 1``).
 
     Solver settings (see :mod:`robodyn.contact.solver`): ``tolerance`` (m/s) the residual
     at which a step's solve stops (the largest velocity error of Coulomb's law, see
     ``solver.coulomb_residual``); ``max_iterations`` per step; ``warn_above`` (m/s): steps
-    that stopped at ``max_iterations`` with a residual above it are reported in a warning
+    whose residual stays above it (at ``max_iterations``) are reported in a warning
     (every step's residual is in the trajectory: a few impacts of redundant contacts, as a
     box's face landing while it slides, stall a little above the tolerance);
     ``stabilization`` the fraction of a penetration removed per step (Baumgarte-like, at

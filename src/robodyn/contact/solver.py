@@ -208,13 +208,19 @@ def delassus(L, Jc, m, Y, G):
             for k in range(i):
                 s -= L[i, k] * Y[k, r]
             Y[i, r] = s / L[i, i]
-    for r in range(3 * m):
+    gram(Y, nv, 3 * m, G)
+
+
+@inline
+def gram(A, rows, cols, out):
+    """``out[:cols, :cols] = A[:rows, :cols]^T A[:rows, :cols]`` (symmetric)."""
+    for r in range(cols):
         for c in range(r + 1):
             s = 0.0
-            for i in range(nv):
-                s += Y[i, r] * Y[i, c]
-            G[r, c] = s
-            G[c, r] = s
+            for i in range(rows):
+                s += A[i, r] * A[i, c]
+            out[r, c] = s
+            out[c, r] = s
 
 
 @inline
@@ -394,14 +400,9 @@ def _active_set_step(G, g, mu, m, Q, sep, ws):
                 d1, d2 = Q[r + 1] / t, Q[r + 2] / t
             A[r + 1, r + 1], A[r + 1, r] = 1.0, -mu[c] * d1
             A[r + 2, r + 2], A[r + 2, r] = 1.0, -mu[c] * d2
+    gram(A, n, n, N)  # N = A^T A + eps I, rhs = A^T b
     trace = 0.0
-    for r in range(n):  # N = A^T A + eps I, rhs = A^T b
-        for c2 in range(r + 1):
-            s = 0.0
-            for k in range(n):
-                s += A[k, r] * A[k, c2]
-            N[r, c2] = s
-            N[c2, r] = s
+    for r in range(n):
         trace += N[r, r]
         s = 0.0
         for k in range(n):

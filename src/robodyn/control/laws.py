@@ -18,6 +18,7 @@ import numpy as np
 from .._jit import inline, kernel
 from ..algorithms.jacobian import jacobian_one
 from ..algorithms.rnea import motion_workspace, rnea_one
+from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import CHECKED, NO_WRENCH, OK
 
 CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
@@ -81,6 +82,13 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
     for k in range(out.shape[0]):
         acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
     return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], NO_WRENCH, CHECKED, out, ws)
+
+
+@kernel
+def law_workspace(nb, nv):
+    """Scratch ``cws`` of :func:`law_torque` for a controller model of ``nb`` bodies and ``nv``
+    dofs: the RNEA's, the reference ``(q_d, v_d, a_d)``, the commanded acceleration, zeros."""
+    return rnea_workspace(nb), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv)
 
 
 @kernel

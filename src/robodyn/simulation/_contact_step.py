@@ -23,7 +23,7 @@ from ..contact.solver import (ACTIVE, BODY, BODY_SPHERE, BOUNCE_SPEED, FRICTION,
                               MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL, RESTITUTION, STABILIZATION, TOLERANCE,
                               backward, cholesky, contact_frame, delassus, forward, point_rows, solve,
                               surface_distance)
-from ..control.laws import law_torque
+from ..control.laws import law_torque, law_workspace
 from ..joints import FREE, PLANAR
 from ..layout import IV, JTYPE
 from ._kernels import chart_point, chart_rate
@@ -220,8 +220,8 @@ def step_kernel(ints, body, dofs, params, fext, fcode, limit, points, centers, r
 def run_workspace(nb, nv, npairs, ncb, nq):
     """Scratch of :func:`run_steps`: the step's, the control law's (a model of ``ncb`` bodies),
     the command, the next state and the warm start."""
-    law_ws = (rnea_workspace(ncb), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv))
-    return (workspace(nb, nv, npairs), law_ws, np.empty(nv), np.empty(nq), np.empty(nv), np.zeros((npairs, 3)))
+    return (workspace(nb, nv, npairs), law_workspace(ncb, nv), np.empty(nv), np.empty(nq), np.empty(nv),
+            np.zeros((npairs, 3)))
 
 
 @inline
