@@ -10,7 +10,8 @@ import pinocchio as pin
 import pytest
 
 import robodyn as rd
-from helpers import G, PLANAR_2R, RANDOM_MODELS, assert_rel, planar_2r, random_models, rng_for, states
+from helpers import G, PLANAR_2R, RANDOM_IDS, RANDOM_MODELS, assert_rel, planar_2r, rng_for, states
+from robodyn import joints as JT
 from test_pinocchio import JACOBIAN_FRAMES
 from urdf_subset import load_pair, pairs
 
@@ -18,9 +19,50 @@ FRAMES = ("world", "local", "local_world_aligned")
 ROWS = {"all": slice(0, 6), "linear": slice(0, 3), "angular": slice(3, 6)}
 
 
-def _body(model):
-    """The last body; it has at least three dofs among its ancestors in every random tree used."""
-    return model.nbodies - 1
+def _ancestor_dofs(model, body):
+    """Number of dofs of the joints from the root to ``body`` (its own joint included)."""
+    n = 0
+    while body >= 0:
+        n += int(JT.NV[model.joint_type[body]])
+        body = int(model.parent[body])
+    return n
+
+
+def _task_jacobian(model, q, body, frame, rows):
+    return rd.jacobian(model, q, body, frame)[ROWS[rows]]
+
+
+def _task_body(model, q, frame, rows, rcond=1e-3):
+    """The body with the most dofs among its ancestors (the last of equals) whose task Jacobian
+    at ``q`` has full row rank with a margin (smallest singular value at least ``rcond`` times
+    the largest); None when no body has one (fewer joints, or rotation axes, than task rows)."""
+    best = None
+    for body in range(model.nbodies):
+        J = _task_jacobian(model, q, body, frame, rows)
+        s = np.linalg.svd(J, compute_uv=False)  # min(m, nv) values, largest first
+        regular = s.size == J.shape[0] and s[-1] > 0 and s[-1] >= rcond * s[0]
+        if regular and (best is None or _ancestor_dofs(model, body) >= _ancestor_dofs(model, best)):
+            best = body
+    return best
+
+
+def _formula_cases():
+    """``(model, frame, rows, body)`` for every random tree, frame and rows that some body can
+    move in every task direction at the state of :func:`test_against_the_formulas`, and
+    ``(model, rows)`` of the trees where no body can, in any frame."""
+    cases, refused = [], []
+    for model, name in zip(RANDOM_MODELS, RANDOM_IDS):
+        for rows in ROWS:
+            bodies = {frame: _task_body(model, states(model, "task", frame, rows)[0], frame, rows) for frame in FRAMES}
+            for frame, body in bodies.items():
+                if body is not None:
+                    cases.append(pytest.param(model, frame, rows, body, id=f"{name}-{frame}-{rows}-body{body}"))
+            if all(body is None for body in bodies.values()):
+                refused.append(pytest.param(model, rows, id=f"{name}-{rows}"))
+    return cases, refused
+
+
+FORMULA_CASES, REFUSED_TASKS = _formula_cases()
 
 
 def _reference(model, q, v, body, frame, rows):
@@ -36,21 +78,11 @@ def _reference(model, q, v, body, frame, rows):
     return Lam, mu, Jbar.T @ g, Jbar, J
 
 
-def _task_rank_ok(model, q, body, frame, rows):
-    J = rd.jacobian(model, q, body, frame)[ROWS[rows]]
-    return np.linalg.matrix_rank(J) == J.shape[0]
-
-
-@random_models
-@pytest.mark.parametrize("frame", FRAMES)
-@pytest.mark.parametrize("rows", ["all", "linear", "angular"])
-def test_against_the_formulas(model, frame, rows):
+@pytest.mark.parametrize("model, frame, rows, body", FORMULA_CASES)
+def test_against_the_formulas(model, frame, rows, body):
+    """Lambda, Jbar, mu, p and J of a body chosen by :func:`_task_body`, so that every case
+    compares values (the refusals are :func:`test_tasks_with_too_few_joints_are_refused`)."""
     q, v, _ = states(model, "task", frame, rows)
-    body = _body(model)
-    if not _task_rank_ok(model, q, body, frame, rows):
-        with pytest.raises(ValueError, match="is singular"):
-            rd.task_space_inertia(model, q, body, frame, rows)
-        return
     Lam, mu, p, Jbar, J = _reference(model, q, v, body, frame, rows)
     assert_rel(rd.task_space_inertia(model, q, body, frame, rows), Lam, 1e-8, "Lambda")
     assert_rel(rd.dynamically_consistent_inverse(model, q, body, frame, rows), Jbar, 1e-8, "Jbar")
@@ -60,15 +92,50 @@ def test_against_the_formulas(model, frame, rows):
         assert_rel(mine, ref, 1e-8, name)
 
 
+def test_formula_cases_cover_every_tree():
+    """The tasks left out of :func:`test_against_the_formulas` are exactly those of trees with
+    too few joints or rotation axes: 1 and 2 dofs (every rows), and the fixed-base trees with
+    at most five dofs above any body, some prismatic (all and angular rows); every other
+    (tree, rows) is compared in the three frames."""
+    assert sorted(c.id for c in REFUSED_TASKS) == sorted(
+        [f"{n}-{r}" for n in ("n1-seed0-fixed-br0.3", "n2-seed2-fixed-br0.5") for r in ROWS]
+        + [f"{n}-{r}" for n in ("n5-seed4-fixed-br0.7", "n15-seed8-fixed-br0.9") for r in ("all", "angular")])
+    assert len(FORMULA_CASES) == 3 * (3 * len(RANDOM_MODELS) - len(REFUSED_TASKS))
+
+
+@pytest.mark.parametrize("model, rows", REFUSED_TASKS)
+def test_tasks_with_too_few_joints_are_refused(model, rows):
+    """No body of the tree can move in every direction of ``rows`` (its task Jacobian has
+    rank below the number of rows, checked here): every task-space function raises a
+    ValueError naming the function, the body, the rows and the frame."""
+    q, v, _ = states(model, "task-refused", rows)
+    m = 6 if rows == "all" else 3
+    deepest = max(range(model.nbodies), key=lambda b: (_ancestor_dofs(model, b), b))
+    for frame in FRAMES:
+        for body in range(model.nbodies):
+            assert np.linalg.matrix_rank(_task_jacobian(model, q, body, frame, rows)) < m
+            with pytest.raises(ValueError) as err:
+                rd.task_space_inertia(model, q, body, frame, rows)
+            assert str(err.value).startswith(f"task_space_inertia: J M^-1 J^T of {body} ({rows} rows, "
+                                             f"frame '{frame}') is singular: eigenvalues "), str(err.value)
+            assert "fewer joints than task rows" in str(err.value)
+        for name, call in (("dynamically_consistent_inverse",
+                            lambda: rd.dynamically_consistent_inverse(model, q, deepest, frame, rows)),
+                           ("task_space_dynamics", lambda: rd.task_space_dynamics(model, q, v, deepest, frame, rows))):
+            with pytest.raises(ValueError, match=rf"^{name}: J M\^-1 J\^T of {deepest} \({rows} rows, "
+                                                 rf"frame '{frame}'\) is singular"):
+                call()
+
+
 @pytest.mark.parametrize("model", [m for m in RANDOM_MODELS if m.nv >= 6], ids=lambda m: m.name)
 @pytest.mark.parametrize("frame", FRAMES)
 def test_task_space_equation_of_motion(model, frame):
     """Joint forces tau = J^T F give the frame x'' = J a + Jdot v with Lambda x'' + mu + p = F;
     Jbar is a right inverse of J and Jbar^T M Jbar = Lambda."""
     q, v, _ = states(model, "eom")
-    body = _body(model)
-    rows = "all" if _task_rank_ok(model, q, body, frame, "all") else "linear"
-    assert _task_rank_ok(model, q, body, frame, rows)
+    rows = "all" if _task_body(model, q, frame, "all") is not None else "linear"
+    body = _task_body(model, q, frame, rows)
+    assert body is not None
     ts = rd.task_space_dynamics(model, q, v, body, frame, rows)
     m = ts.J.shape[0]
     F = rng_for(model.name, "F").standard_normal(m)
