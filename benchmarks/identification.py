@@ -81,7 +81,7 @@ def main() -> None:
             f"Pinocchio loop {t_pin / n * 1e6:.2f} us per state")
 
     t0 = time.perf_counter()
-    base = ident.base_parameters(model, viscous=True, coulomb=True)
+    base = ident.base_parameters(model, damping=True, coulomb=True)
     say(f"base parameters: {base.count - 14} inertial + 14 friction = {base.count} "
         f"(gap {base.gap:.3g}) in {time.perf_counter() - t0:.2f} s")
 

@@ -22,8 +22,8 @@ def test_inverse_of_rnea(model):
 def test_inverse_of_rnea_with_external_wrenches(model, frame):
     q, v, a = states(model, frame)
     f_ext = rng_for(model.name, frame).standard_normal((model.nbodies, 6))
-    tau = rd.rnea(model, q, v, a, f_ext, f_ext_frame=frame)
-    assert_rel(rd.aba(model, q, v, tau, f_ext, f_ext_frame=frame), a, 1e-9)
+    tau = rd.rnea(model, q, v, a, f_ext, frame=frame)
+    assert_rel(rd.aba(model, q, v, tau, f_ext, frame=frame), a, 1e-9)
 
 
 @random_models
@@ -34,8 +34,8 @@ def test_inverse_of_rnea_with_friction_armature_and_wrenches(model, smoothing, f
     q, v, a = states(m, smoothing, frame)
     f_ext = rng_for(model.name, "f", frame).standard_normal((model.nbodies, 6))
     for kw in ({}, {"friction": False}, {"armature": False}, {"friction": False, "armature": False}):
-        tau = rd.rnea(m, q, v, a, f_ext, f_ext_frame=frame, **kw)
-        assert_rel(rd.aba(m, q, v, tau, f_ext, f_ext_frame=frame, **kw), a, 1e-9, str(kw))
+        tau = rd.rnea(m, q, v, a, f_ext, frame=frame, **kw)
+        assert_rel(rd.aba(m, q, v, tau, f_ext, frame=frame, **kw), a, 1e-9, str(kw))
 
 
 @random_models

@@ -24,7 +24,7 @@ def test_aba_derivatives_are_the_differences_of_aba(model):
     m = with_friction_and_armature(model, rng, 0.2)
     q, v, tau = states(model, "aba-derivatives")
     f = rng.standard_normal((model.nbodies, 6))
-    for kw in ({}, *({"f_ext": f, "f_ext_frame": frame} for frame in F_EXT_FRAMES)):
+    for kw in ({}, *({"f_ext": f, "frame": frame} for frame in F_EXT_FRAMES)):
         dq, dv, dtau = rd.aba_derivatives(m, q, v, tau, **kw)
         fd_q, fd_v = tangent_differences(rd.aba, m, q, v, tau, **kw)
         assert_rel(dq, fd_q, FD_TOL, "dqdd_dq")

@@ -19,7 +19,7 @@ from test_control import assert_lyapunov_rate
 def mismatched(model):
     """The model with each body's inertial parameters scaled by 1.3 or 0.7 (alternately)."""
     scale = np.where(np.arange(model.nbodies) % 2 == 0, 1.3, 0.7)
-    return model.replace(inertia=model.inertia * scale[:, None])
+    return model.replace(theta=model.theta * scale[:, None])
 
 
 def sinusoid(q_mid, amplitude, w):
@@ -49,7 +49,7 @@ def tracking(plant, reference, controller, e0, duration, dt):
 # for dt = 2, 1, 0.5 ms; its wrist's fast transient makes it the larger one).
 @pytest.mark.parametrize("name, duration, columns, tol", [
     ("planar_2r", 3.0, {}, 5e-5),
-    ("puma560", 1.5, dict(viscous=True, armature=True), 1e-3),
+    ("puma560", 1.5, dict(damping=True, armature=True), 1e-3),
 ], ids=["planar_2r", "puma560"])
 def test_adaptive_tracking_with_wrong_model(name, duration, columns, tol):
     """Wrong masses and inertias: the error converges, V never increases and V(t) - V(0) is
@@ -84,7 +84,7 @@ def test_exact_estimates_give_slotine_li():
     plant = rd.models.load("puma560")
     rng = rng_for("exact")
     reference = sinusoid(rng.uniform(-1, 1, plant.nv), 0.3, 1.5)
-    columns = dict(viscous=True, coulomb=True, armature=True)
+    columns = dict(damping=True, coulomb=True, armature=True)
     G = rng.standard_normal((plant.nv * 3 + 10 * plant.nbodies,) * 2)
     gamma = G @ G.T + np.eye(G.shape[0])
     ad = control.AdaptiveSlotineLi(mismatched(plant), reference, 2.0, 3.0, gamma, theta_true=plant, **columns)
@@ -155,7 +155,7 @@ def test_bad_input():
     with pytest.raises(ValueError, match="gamma: the matrix must be positive definite"):
         make(gamma=-np.eye(20))
     with pytest.raises(ValueError, match=r"theta0: expected \(22,\) finite numbers .* got shape \(20,\)"):
-        make(theta0=np.ones(20), viscous=True)
+        make(theta0=np.ones(20), damping=True)
     with pytest.raises(ValueError, match=r"theta0: expected \(20,\) finite numbers"):
         make(theta0=np.full(20, np.nan))
     with pytest.raises(ValueError, match=r"theta_true: the model has nq=6, nv=6, 6 bodies"):

@@ -171,8 +171,8 @@ def test_placeholder_links_merged_into_consistent_bodies_load():
     assert model.link_names == ("shank",)
     floating = b.build(floating_base=True)  # the root link moves now, merged with trunk and base
     assert floating.link_names == ("world_marker", "shank")
-    np.testing.assert_allclose(floating.inertia[0, 4:], [0.11, 0.0, 0.21, 0.0, 0.0, 0.260003])  # trunk + base + marker
-    assert floating.inertia[1, 9] == pytest.approx(1e-4 + 1e-6)
+    np.testing.assert_allclose(floating.theta[0, 4:], [0.11, 0.0, 0.21, 0.0, 0.0, 0.260003])  # trunk + base + marker
+    assert floating.theta[1, 9] == pytest.approx(1e-4 + 1e-6)
 
 
 def test_merged_body_failure_names_every_link():
@@ -271,7 +271,7 @@ def test_fixed_merge_with_rotation_argument():
     b.add_joint("weld", "fixed", "arm", "tool", xyz=p, rotation=R)
     model = b.build()
     expected = inertial_parameters_from(1.0, (0, 0, 0.1), I3) + inertial_parameters_from(0.3, p + R @ c2, R @ I2 @ R.T)
-    np.testing.assert_allclose(model.inertia[0], expected, rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(model.theta[0], expected, rtol=1e-13, atol=1e-16)
     body, Rf, pf = model.frame_index("tool")
     assert body == 0
     np.testing.assert_allclose(Rf, R, atol=1e-15)

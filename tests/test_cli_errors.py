@@ -24,7 +24,7 @@ def _inputs(tmp_path):
     header = "t," + ",".join(f"q:{j}" for j in JOINTS)
     nan = tmp_path / "nan.csv"
     nan.write_text(header + "\n" + "\n".join(f"{k * 0.1}," + ",".join(["nan"] * 9) for k in range(4)) + "\n")
-    log_header = "time," + ",".join(f"q_{j}" for j in JOINTS) + "," + ",".join(f"tau_{j}" for j in JOINTS)
+    log_header = "t," + ",".join(f"q:{j}" for j in JOINTS) + "," + ",".join(f"tau:{j}" for j in JOINTS)
     log_nan = tmp_path / "log_nan.csv"
     log_nan.write_text(log_header + "\n" + "\n".join(f"{k * 0.1}," + ",".join(["nan"] * 18) for k in range(4)) + "\n")
     huge = tmp_path / "huge.csv"

@@ -8,7 +8,7 @@ import pytest
 
 import robodyn as rd
 from robodyn.cli import main
-from robodyn.simulation import read_csv
+from robodyn.simulation import read_trajectory
 
 
 def test_simulate_then_torques(tmp_path, capsys):
@@ -20,7 +20,7 @@ def test_simulate_then_torques(tmp_path, capsys):
     for f in (png, gif, csv):
         assert f.stat().st_size > 0, f
     model = rd.models.load("planar_2r")
-    t, q, v, a = read_csv(model, csv)
+    t, q, v, a = read_trajectory(csv, model)
     assert t.shape == (401,) and q.shape == (401, 2)
     contributions = tmp_path / "contributions.png"
     assert main(["torques", "planar_2r", str(csv), "--plot", str(contributions)]) == 0
@@ -30,7 +30,7 @@ def test_simulate_then_torques(tmp_path, capsys):
     tracked = tmp_path / "tracked.csv"
     assert main(["simulate", "planar_2r", "--controller", "computed-torque", "--duration", "0.2", "--reference",
                  str(csv), "--csv", str(tracked)]) == 0
-    _, q_tracked, _, _ = read_csv(model, tracked)
+    _, q_tracked, _, _ = read_trajectory(tracked, model)
     np.testing.assert_allclose(q_tracked, q[:201], rtol=0, atol=1e-6)
 
 

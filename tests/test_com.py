@@ -15,7 +15,7 @@ from helpers import (assert_rel, check_batch, check_input_validation, input_chec
 def com_from_poses(model, q):
     """sum_i m_i (p_i + R_i c_i) / m from forward_kinematics and the inertial parameters."""
     T = rd.forward_kinematics(model, q)
-    moment = sum(model.inertia[i, 0] * T[i, :3, 3] + T[i, :3, :3] @ model.inertia[i, 1:4] for i in range(model.nbodies))
+    moment = sum(model.theta[i, 0] * T[i, :3, 3] + T[i, :3, :3] @ model.theta[i, 1:4] for i in range(model.nbodies))
     return moment / model.total_mass
 
 
@@ -41,7 +41,7 @@ def test_linear_momentum(model):
     for b in range(model.nbodies):
         lin, ang = np.split(rd.jacobian(model, q, b, frame="local_world_aligned") @ v, 2)
         R = rd.forward_kinematics(model, q)[b, :3, :3]
-        momentum += model.inertia[b, 0] * lin + np.cross(ang, R @ model.inertia[b, 1:4])
+        momentum += model.theta[b, 0] * lin + np.cross(ang, R @ model.theta[b, 1:4])
     assert_rel(model.total_mass * rd.com_jacobian(model, q) @ v, momentum, 1e-9)
 
 

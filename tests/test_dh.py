@@ -102,7 +102,7 @@ def test_inertia_given_in_dh_frame_is_moved_to_the_body():
     model = rd.from_dh(_table(mass=2.0, com=com, inertia=Ic), convention="standard")
     # frame 1 sits at (Rx(alpha1), (a1, 0, d1)) on body 1
     R, p = rot("x", ALPHA1), np.array([A1, 0, D1])
-    np.testing.assert_allclose(model.inertia[0], inertial_parameters_from(2.0, p + R @ com, R @ Ic @ R.T),
+    np.testing.assert_allclose(model.theta[0], inertial_parameters_from(2.0, p + R @ com, R @ Ic @ R.T),
                                rtol=1e-13, atol=1e-16)
     assert model.total_mass == 2.0
 

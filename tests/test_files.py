@@ -56,7 +56,7 @@ def test_trajectory_csv_interrupted_leaves_nothing(tmp_path, monkeypatch):
     good = tmp_path / "good.csv"
     traj.to_csv(good)
     assert good.read_text().count("\n") == traj.t.shape[0] + 1
-    import robodyn.simulation.trajectory as T
+    import robodyn.io.log as T
 
     monkeypatch.setattr(T.csv, "writer", _FailingWriter)
     with pytest.raises(OSError):

@@ -73,7 +73,7 @@ def assert_same_model(mine: rd.Model, ref: rd.Model, exact_inertia: bool = False
     for key in ("parent", "joint_type", "idx_q", "idx_v", "frame_body", "lower", "upper", "velocity_limit",
                 "effort_limit", "damping", "coulomb", "armature", "gravity"):
         np.testing.assert_array_equal(getattr(mine, key), getattr(ref, key), err_msg=key)
-    for key in ("joint_axis", "X_tree_R", "X_tree_p", "frame_R", "frame_p", "inertia"):
+    for key in ("joint_axis", "X_tree_R", "X_tree_p", "frame_R", "frame_p", "theta"):
         np.testing.assert_allclose(getattr(mine, key), getattr(ref, key), rtol=1e-12, atol=1e-14, err_msg=key)
 
 
@@ -211,7 +211,7 @@ def test_round_trip_of_a_builtin_model_with_a_massless_body():
     b.add_joint("j1", "revolute", "base", "a", axis=(0, 0, -1), lower=-1, upper=2, velocity=3, effort=4)
     b.add_joint("j2", "prismatic", "a", "ghost", xyz=(0.2, 0, 0), axis=(1, 1, 0))
     model = b.build()
-    assert model.inertia[1].tolist() == [0.0] * 10
+    assert model.theta[1].tolist() == [0.0] * 10
     assert_same_model(from_pinocchio(to_pinocchio(model)), model)
 
 
@@ -299,7 +299,7 @@ def test_unphysical_inertia_and_rotor_inertia():
         from_pinocchio(pm)
     with pytest.warns(rd.RobodynWarning, match=r"body 0 \('j', joint 'j'\).*triangle inequality.*kept as given"):
         model = from_pinocchio(pm, physical="warn")
-    assert model.inertia[0, 9] == 3.0
+    assert model.theta[0, 9] == 3.0
     pm.inertias[j] = pin.Inertia(1.0, np.zeros(3), np.eye(3))
     pm.rotorInertia = np.array([0.5])
     with pytest.warns(rd.RobodynWarning, match=r"rotorInertia \[0.5\] not converted"):

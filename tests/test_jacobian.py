@@ -78,7 +78,7 @@ def test_kinetic_energy_from_body_velocities(model):
     q, v, _ = states(model)
     energy = 0.0
     for b in range(model.nbodies):
-        m, h, t = model.inertia[b, 0], model.inertia[b, 1:4], model.inertia[b, 4:]
+        m, h, t = model.theta[b, 0], model.theta[b, 1:4], model.theta[b, 4:]
         I = np.array([[t[0], t[1], t[3]], [t[1], t[2], t[4]], [t[3], t[4], t[5]]])
         lin, ang = np.split(rd.jacobian(model, q, b, frame="local") @ v, 2)
         energy += 0.5 * (m * lin @ lin + ang @ I @ ang) + lin @ np.cross(ang, h)

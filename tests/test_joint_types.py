@@ -203,8 +203,8 @@ def test_spherical_pendulum_conserves_energy_and_vertical_angular_momentum():
 
 def test_coordinate_names_and_display():
     model = spherical_pendulum()
-    from robodyn.io.trajectory_csv import coordinate_names
-    assert coordinate_names(model) == (["ball:qx", "ball:qy", "ball:qz", "ball:qw"], ["ball:wx", "ball:wy", "ball:wz"])
+    assert model.q_names == ["ball:qx", "ball:qy", "ball:qz", "ball:qw"]
+    assert model.dof_names == ["ball:wx", "ball:wy", "ball:wz"]
     assert "spherical" in str(model)
     assert (model.lower == -np.inf).all() and (model.upper == np.inf).all()
 

@@ -27,7 +27,7 @@ def test_named_columns_hold_the_model(seed):
     np.testing.assert_array_equal(k.body[:, L.XTREE_R:L.XTREE_R + 9], m.X_tree_R.reshape(-1, 9))
     np.testing.assert_array_equal(k.body[:, L.XTREE_P:L.XTREE_P + 3], m.X_tree_p)
     np.testing.assert_array_equal(k.body[:, L.JOINT_AXIS:L.JOINT_AXIS + 3], m.joint_axis)
-    np.testing.assert_array_equal(k.body[:, L.INERTIA:L.INERTIA_END], m.inertia)
+    np.testing.assert_array_equal(k.body[:, L.INERTIA:L.INERTIA_END], m.theta)
     for i in range(m.nbodies):
         np.testing.assert_array_equal(k.body[i, L.JOINT_CONSTANTS:],
                                       J.joint_constants(int(m.joint_type[i]), m.joint_axis[i], m.X_tree_R[i]))

@@ -263,7 +263,7 @@ def test_several_joints_in_one_body_make_a_chain_of_massless_bodies():
     model = check(xml)
     assert model.link_names == ("hip:x", "hip:y", "hip", "shin")
     assert model.body_joint_names == ("x", "y", "s", "knee")
-    assert model.inertia[0, 0] == model.inertia[1, 0] == 0
+    assert model.theta[0, 0] == model.theta[1, 0] == 0
 
 
 def test_ball_joints_are_spherical_joints():
@@ -329,7 +329,7 @@ def test_inertia_from_geoms_off():
                 '<geom size="0.5"/><body name="c" pos="0 0.3 0"><joint axis="1 0 0"/><geom size="0.1"/></body></body>',
                 head='<compiler inertiafromgeom="false"/>')
     model = _load_quietly(xml)
-    np.testing.assert_array_equal(model.inertia[:, 0], [2.0, 0.0])
+    np.testing.assert_array_equal(model.theta[:, 0], [2.0, 0.0])
     with pytest.raises(ValueError, match="mass and inertia of moving bodies"):
         mujoco.MjModel.from_xml_string(xml)
 

@@ -16,7 +16,7 @@ def model() -> rd.Model:
     return small_tree_builder().build()
 
 
-ARRAY_FIELDS = ("parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "idx_q", "idx_v",
+ARRAY_FIELDS = ("parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta", "idx_q", "idx_v",
                 "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature", "gravity",
                 "frame_body", "frame_R", "frame_p")
 
@@ -47,17 +47,17 @@ def test_attributes_cannot_be_set_or_deleted(model):
         with pytest.raises(AttributeError, match="immutable"):
             setattr(model, name, value)
     with pytest.raises(AttributeError, match="immutable"):
-        del model.inertia
-    assert model.nq == 3 and model.inertia.shape == (3, 10)
+        del model.theta
+    assert model.nq == 3 and model.theta.shape == (3, 10)
     assert isinstance(model.link_names, tuple) and isinstance(model.joint_names, tuple)
 
 
 def test_inertial_parameters_round_trip(model):
     theta = model.inertial_parameters()
     assert theta.shape == (10 * model.nbodies,)
-    np.testing.assert_array_equal(theta, model.inertia.reshape(-1))
+    np.testing.assert_array_equal(theta, model.theta.reshape(-1))
     theta[0] = 123.0  # a copy: the model does not change
-    assert model.inertia[0, 0] != 123.0
+    assert model.theta[0, 0] != 123.0
     same = model.with_inertial_parameters(model.inertial_parameters())
     assert same is not model
     for field in ARRAY_FIELDS:
@@ -68,7 +68,7 @@ def test_inertial_parameters_round_trip(model):
 def test_with_inertial_parameters_changes_only_inertia(model):
     scaled = model.with_inertial_parameters(2.0 * model.inertial_parameters())
     assert scaled.total_mass == pytest.approx(2.0 * model.total_mass)
-    np.testing.assert_array_equal(scaled.inertia, 2.0 * model.inertia)
+    np.testing.assert_array_equal(scaled.theta, 2.0 * model.theta)
     np.testing.assert_array_equal(scaled.X_tree_p, model.X_tree_p)
     assert model.total_mass == pytest.approx(3.6)  # the original is untouched
 
@@ -83,7 +83,7 @@ def test_with_inertial_parameters_wrong_shape(model, shape):
 
 
 def _theta_with(model, body, **changes):
-    theta = model.inertia.copy()
+    theta = model.theta.copy()
     names = dict(m=0, hx=1, hy=2, hz=3, ixx=4, ixy=5, iyy=6, ixz=7, iyz=8, izz=9)
     for k, v in changes.items():
         theta[body, names[k]] = v
@@ -112,7 +112,7 @@ def test_zero_mass_with_first_moment_refused(model):
 def test_physical_warn_model_keeps_unphysical_but_not_non_finite():
     model = small_tree_builder(physical="warn").build()
     kept = model.with_inertial_parameters(_theta_with(model, 1, izz=10.0))
-    assert kept.inertia[1, 9] == 10.0
+    assert kept.theta[1, 9] == 10.0
     for bad in (dict(m=-1.0), dict(m=np.nan)):
         with pytest.raises(rd.ModelError, match="finite with mass >= 0"):
             model.with_inertial_parameters(_theta_with(model, 1, **bad))
@@ -165,7 +165,7 @@ def _kwargs(parent=(-1, 0), joint_type=(J.REVOLUTE, J.PRISMATIC), **changes):
     kw = dict(
         parent=parent, joint_type=joint_type, joint_axis=np.tile([0.0, 0.0, 1.0], (nb, 1)),
         X_tree_R=np.tile(np.eye(3), (nb, 1, 1)), X_tree_p=np.zeros((nb, 3)),
-        inertia=np.tile(inertial_parameters_from(1.0, (0, 0, 0.1), np.eye(3) * 0.01), (nb, 1)),
+        theta=np.tile(inertial_parameters_from(1.0, (0, 0, 0.1), np.eye(3) * 0.01), (nb, 1)),
         link_names=[f"l{i}" for i in range(nb)], body_joint_names=[f"j{i}" for i in range(nb)],
     )
     kw.update(changes)
@@ -224,7 +224,7 @@ def _ancestors_and_self(parent, j):
     (dict(X_tree_p=np.array([[0, 0, np.inf], [0, 0, 0]])), "X_tree_p is not finite"),
     (dict(X_tree_R=np.tile(2 * np.eye(3), (2, 1, 1))), "not a rotation matrix"),
     (dict(X_tree_R=np.tile(np.diag([1.0, 1.0, -1.0]), (2, 1, 1))), "not a rotation matrix"),
-    (dict(inertia=np.zeros((2, 9))), "inertia must have shape"),
+    (dict(theta=np.zeros((2, 9))), "theta must have shape"),
     (dict(link_names=["a"]), "need 2 entries"),
     (dict(link_names=["a", "a"]), "duplicate link or frame names"),
     (dict(body_joint_names=["j", "j"]), "duplicate joint names"),

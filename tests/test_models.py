@@ -92,7 +92,7 @@ def mass_and_com(theta):
 
 
 def com_world(model, q):
-    return [p + R @ mass_and_com(th)[1] for (R, p), th in zip(body_poses(model, q), model.inertia)]
+    return [p + R @ mass_and_com(th)[1] for (R, p), th in zip(body_poses(model, q), model.theta)]
 
 
 def mass_matrix_fd(model, q, h=1e-6):
@@ -111,14 +111,14 @@ def mass_matrix_fd(model, q, h=1e-6):
             Jw[b, :, k] = [W[2, 1], W[0, 2], W[1, 0]]
     M = np.diag(model.armature).astype(float)
     for b, (R, _) in enumerate(body_poses(model, q)):
-        m, _, Ic = mass_and_com(model.inertia[b])
+        m, _, Ic = mass_and_com(model.theta[b])
         M += m * Jv[b].T @ Jv[b] + Jw[b].T @ (R @ Ic @ R.T) @ Jw[b]
     return M
 
 
 def gravity_fd(model, q, h=1e-6):
     """g(q) = dV/dq with V = -sum m gravity . c."""
-    masses = model.inertia[:, 0]
+    masses = model.theta[:, 0]
 
     def V(x):
         return -sum(m * model.gravity @ c for m, c in zip(masses, com_world(model, x)))
@@ -174,7 +174,7 @@ def test_link_inertials_survive_loading(name):
     model = rd.models.load(name)
     for i, link in enumerate(module.links(), start=1):
         body, R, p = model.frame_index(f"frame{i}")
-        m, c, Ic = mass_and_com(model.inertia[body])
+        m, c, Ic = mass_and_com(model.theta[body])
         assert m == pytest.approx(link.mass, abs=1e-12)
         if m > 0:
             np.testing.assert_allclose(R.T @ (c - p), link.com, atol=1e-12)

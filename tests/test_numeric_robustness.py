@@ -29,7 +29,7 @@ SLACK = 4.0  # constant of the error bounds, which grow with the number of joint
 
 def _scaled(model: rd.Model, masses: np.ndarray) -> rd.Model:
     """``model`` with body ``i``'s inertial parameters multiplied by ``masses[i]``."""
-    return model.replace(inertia=model.inertia * np.asarray(masses)[:, None])
+    return model.replace(theta=model.theta * np.asarray(masses)[:, None])
 
 
 def _cases():

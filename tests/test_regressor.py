@@ -37,9 +37,9 @@ def test_regressor_is_linear_in_each_body(model):
     Y = rd.regressor(model, q, v, a)
     for i in range(model.nbodies):
         theta = np.zeros(10 * model.nbodies)
-        theta[10 * i:10 * i + 10] = model.inertia[i]
-        alone = model.replace(inertia=theta.reshape(-1, 10), physical="warn")
-        assert_rel(Y[:, 10 * i:10 * i + 10] @ model.inertia[i],
+        theta[10 * i:10 * i + 10] = model.theta[i]
+        alone = model.replace(theta=theta.reshape(-1, 10), physical="warn")
+        assert_rel(Y[:, 10 * i:10 * i + 10] @ model.theta[i],
                    rd.rnea(alone, q, v, a, friction=False, armature=False), 1e-10, f"body {i}")
 
 
@@ -52,18 +52,18 @@ def test_friction_armature_and_offset_columns(model, smoothing):
     q, v, a = states(model, "extra", smoothing, size=3)
     v[0, 0] = 0.0  # Coulomb column at rest: sgn(0) = 0, as in rnea
     offset = rng.standard_normal(model.nv)
-    Y = rd.regressor(m, q, v, a, viscous=True, coulomb=True, armature=True, offset=True)
+    Y = rd.regressor(m, q, v, a, damping=True, coulomb=True, armature=True, offset=True)
     nb, nv = model.nbodies, model.nv
     assert Y.shape == (3, nv, 10 * nb + 4 * nv)
-    theta = extended_parameters(m, viscous=True, coulomb=True, armature=True, offset=offset)
+    theta = extended_parameters(m, damping=True, coulomb=True, armature=True, offset=offset)
     assert_rel(Y @ theta, rd.rnea(m, q, v, a) + offset, 1e-10)
     assert_rel(Y[..., :10 * nb], rd.regressor(m, q, v, a), 0.0)
     sgn = np.tanh(v / smoothing) if smoothing else np.sign(v)
     for block, expected in enumerate((v, sgn, a, np.ones_like(v))):
         cols = Y[..., 10 * nb + block * nv:10 * nb + (block + 1) * nv]
         assert_rel(cols, expected[:, :, None] * np.eye(nv), 1e-15, f"block {block}")
-    names = extra_columns(m, viscous=True, coulomb=True, armature=True, offset=True)
-    assert len(names) == 4 * nv and names[0] == f"viscous[{rd.algorithms.regressor.dof_names(m)[0]}]"
+    names = extra_columns(m, damping=True, coulomb=True, armature=True, offset=True)
+    assert len(names) == 4 * nv and names[0] == f"damping[{m.dof_names[0]}]"
     only = rd.regressor(m, q, v, a, coulomb=True, offset=True)
     assert_rel(only[..., 10 * nb:], np.concatenate([Y[..., 10 * nb + nv:10 * nb + 2 * nv],
                                                     Y[..., 10 * nb + 3 * nv:]], axis=-1), 0.0)
@@ -120,7 +120,7 @@ def test_agrees_with_pinocchio(path, floating_base):
     assert not isinstance(pair, Exception), f"Pinocchio refuses {erd_id(path)}: {pair}"
     model, pm, data = pair.model, pair.pm, pair.data
     for j in range(1, pm.njoints):
-        assert_rel(model.inertia[j - 1], pm.inertias[j].toDynamicParameters(), 1e-12, "parameters")
+        assert_rel(model.theta[j - 1], pm.inertias[j].toDynamicParameters(), 1e-12, "parameters")
     rng = rng_for(erd_id(path), floating_base, "regressor")
     q, v, a = rd.random.random_state(model, rng)
     Y = rd.regressor(model, q, v, a)
@@ -141,7 +141,7 @@ def test_robot_without_joints():
     b.add_link("base", mass=1.0, inertia=np.eye(3))
     model = b.build()
     assert rd.regressor(model, np.zeros(0), np.zeros(0), np.zeros(0)).shape == (0, 0)
-    assert rd.regressor(model, np.zeros((3, 0)), np.zeros(0), np.zeros(0), viscous=True).shape == (3, 0, 0)
+    assert rd.regressor(model, np.zeros((3, 0)), np.zeros(0), np.zeros(0), damping=True).shape == (3, 0, 0)
     assert rd.kinetic_energy_regressor(model, np.zeros(0), np.zeros(0)).shape == (0,)
     assert rd.potential_energy_regressor(model, np.zeros((2, 0))).shape == (2, 0)
 

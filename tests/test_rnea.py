@@ -23,7 +23,7 @@ def test_wrench_on_one_body_is_jacobian_transpose(model, frame):
         f_ext = np.zeros((model.nbodies, 6))
         f_ext[b] = w
         expected = tau0 - rd.jacobian(model, q, b, frame=frame).T @ w
-        assert_rel(rd.rnea(model, q, v, a, f_ext, f_ext_frame=frame), expected, 1e-9, f"body {b}")
+        assert_rel(rd.rnea(model, q, v, a, f_ext, frame=frame), expected, 1e-9, f"body {b}")
 
 
 @random_models
@@ -108,11 +108,11 @@ def test_batch_with_external_wrenches():
     q, v, a = states(model, "fext-batch", size=(2, 3))
     f_ext = rng_for("fext-batch").standard_normal((2, 3, model.nbodies, 6))
     for frame in F_EXT_FRAMES:
-        out = rd.rnea(model, q, v, a, f_ext, f_ext_frame=frame)
-        shared = rd.rnea(model, q, v, a, f_ext[0, 0], f_ext_frame=frame)
+        out = rd.rnea(model, q, v, a, f_ext, frame=frame)
+        shared = rd.rnea(model, q, v, a, f_ext[0, 0], frame=frame)
         for i in np.ndindex(2, 3):
-            assert_rel(out[i], rd.rnea(model, q[i], v[i], a[i], f_ext[i], f_ext_frame=frame), 1e-12)
-            assert_rel(shared[i], rd.rnea(model, q[i], v[i], a[i], f_ext[0, 0], f_ext_frame=frame), 1e-12)
+            assert_rel(out[i], rd.rnea(model, q[i], v[i], a[i], f_ext[i], frame=frame), 1e-12)
+            assert_rel(shared[i], rd.rnea(model, q[i], v[i], a[i], f_ext[0, 0], frame=frame), 1e-12)
 
 
 @input_checks
@@ -134,5 +134,5 @@ def test_bad_external_wrenches():
         rd.rnea(model, q, v, a, f)
     with pytest.raises(ValueError, match="^f_ext: batch shape"):
         rd.rnea(model, q, v, a, np.zeros((4, nb, 6)))  # would enlarge an unbatched call
-    with pytest.raises(ValueError, match="^f_ext_frame must be one of"):
-        rd.rnea(model, q, v, a, np.zeros((nb, 6)), f_ext_frame="body")
+    with pytest.raises(ValueError, match="^frame must be one of"):
+        rd.rnea(model, q, v, a, np.zeros((nb, 6)), frame="body")

@@ -23,7 +23,7 @@ from robodyn.random import random_model
 def test_rnea_derivatives_are_the_differences_of_rnea(model, frame):
     rng = rng_for(model.name, "rnea-derivatives", frame)
     q, v, a = states(model, "rnea-derivatives", frame)
-    kw = {} if frame is None else {"f_ext": rng.standard_normal((model.nbodies, 6)), "f_ext_frame": frame}
+    kw = {} if frame is None else {"f_ext": rng.standard_normal((model.nbodies, 6)), "frame": frame}
     dq, dv, da = rd.rnea_derivatives(model, q, v, a, **kw)
     fd_q, fd_v = tangent_differences(rd.rnea, model, q, v, a, **kw)
     assert_rel(dq, fd_q, FD_TOL, "dtau_dq")
@@ -39,7 +39,7 @@ def test_friction_and_armature(model, smoothing):
     q, v, a = states(model, "friction", smoothing)
     f = rng.standard_normal((model.nbodies, 6))
     dq, dv, da = rd.rnea_derivatives(m, q, v, a, f, "world")
-    fd_q, fd_v = tangent_differences(rd.rnea, m, q, v, a, f_ext=f, f_ext_frame="world")
+    fd_q, fd_v = tangent_differences(rd.rnea, m, q, v, a, f_ext=f, frame="world")
     assert_rel(dq, fd_q, FD_TOL, "dtau_dq")
     assert_rel(dv, fd_v, FD_TOL, "dtau_dv")
     assert_rel(da, rd.crba(m, q), 1e-12, "dtau_da with armature")
@@ -92,7 +92,7 @@ def breadth_first_tree():
     base = random_model(6, seed=1)
     return rd.Model(parent=[-1, 0, 0, 1, 2, 3], joint_type=[0, 0, 1, 0, 0, 0],
                     joint_axis=rng.standard_normal((6, 3)), X_tree_R=base.X_tree_R,
-                    X_tree_p=rng.standard_normal((6, 3)), inertia=base.inertia,
+                    X_tree_p=rng.standard_normal((6, 3)), theta=base.theta,
                     link_names=[f"l{i}" for i in range(6)], body_joint_names=[f"j{i}" for i in range(6)])
 
 

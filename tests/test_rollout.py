@@ -80,20 +80,20 @@ def test_each_rollout_may_carry_its_own_masses():
     the model with its parameters; unphysical ones are refused, naming the rollout and body."""
     q0, v0 = box_states(1, seed=3)
     scale = np.array([0.5, 1.0, 2.0])
-    theta = scale[:, None, None] * BOX.inertia[None]
-    R = rd.rollout(BOX, q0[0], v0[0], 0.3, 1e-3, contacts=BOX_CONTACTS, inertia=theta)
+    theta = scale[:, None, None] * BOX.theta[None]
+    R = rd.rollout(BOX, q0[0], v0[0], 0.3, 1e-3, contacts=BOX_CONTACTS, theta=theta)
     assert R.q.shape[0] == 3
     for b in range(3):
-        traj = rd.simulate(BOX.replace(inertia=theta[b]), q0[0], v0[0], 0.3, 1e-3, contacts=BOX_CONTACTS)
+        traj = rd.simulate(BOX.replace(theta=theta[b]), q0[0], v0[0], 0.3, 1e-3, contacts=BOX_CONTACTS)
         np.testing.assert_array_equal(R.q[b], traj.q)
         np.testing.assert_array_equal(R.contact_force[b], traj.contact_force)
     assert not np.allclose(R.contact_force[0], R.contact_force[2])
     bad = theta.copy()
     bad[1, 0, 4] = -1.0  # Ixx < 0
-    with pytest.raises(ValueError, match=r"inertia: rollout 1, body 0 \('body'\)"):
-        rd.rollout(BOX, q0[0], v0[0], 0.1, 1e-3, inertia=bad)
-    with pytest.raises(ValueError, match=r"inertia: expected shape \(3, 1, 10\)"):
-        rd.rollout(BOX, np.tile(q0[0], (3, 1)), v0[0], 0.1, 1e-3, inertia=theta[:2])
+    with pytest.raises(ValueError, match=r"theta: rollout 1, body 0 \('body'\)"):
+        rd.rollout(BOX, q0[0], v0[0], 0.1, 1e-3, theta=bad)
+    with pytest.raises(ValueError, match=r"theta: expected shape \(3, 1, 10\)"):
+        rd.rollout(BOX, np.tile(q0[0], (3, 1)), v0[0], 0.1, 1e-3, theta=theta[:2])
 
 
 def test_one_state_broadcasts():

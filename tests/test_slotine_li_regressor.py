@@ -61,9 +61,9 @@ def test_each_column_block_is_one_body(model):
     Y = rd.slotine_li_regressor(model, q, v, v_r, a_r)
     for i in range(model.nbodies):
         theta = np.zeros((model.nbodies, 10))
-        theta[i] = model.inertia[i]
-        alone = model.replace(inertia=theta, physical="warn")
-        assert_rel(Y[:, 10 * i:10 * i + 10] @ model.inertia[i], expected(alone, q, v, v_r, a_r), 1e-10, f"body {i}")
+        theta[i] = model.theta[i]
+        alone = model.replace(theta=theta, physical="warn")
+        assert_rel(Y[:, 10 * i:10 * i + 10] @ model.theta[i], expected(alone, q, v, v_r, a_r), 1e-10, f"body {i}")
     Y2 = rd.slotine_li_regressor(model, q, v, 2.0 * v_r - v, a_r)
     Y0 = rd.slotine_li_regressor(model, q, v, 0 * v, 0 * a_r)
     assert_rel(Y2 - Y0, 2.0 * (Y - Y0) - (rd.slotine_li_regressor(model, q, v, v, a_r) - Y0), 1e-10, "linear")
@@ -80,10 +80,10 @@ def test_friction_armature_and_offset_columns(model, smoothing):
     q, v, v_r, a_r = reference_states(model, "sl-extra", smoothing, size=3)
     v[0, 0] = 0.0  # Coulomb column at rest: sgn(0) = 0, as in rnea
     offset = rng.standard_normal(model.nv)
-    Y = rd.slotine_li_regressor(m, q, v, v_r, a_r, viscous=True, coulomb=True, armature=True, offset=True)
+    Y = rd.slotine_li_regressor(m, q, v, v_r, a_r, damping=True, coulomb=True, armature=True, offset=True)
     nb, nv = model.nbodies, model.nv
     assert Y.shape == (3, nv, 10 * nb + 4 * nv)
-    theta = extended_parameters(m, viscous=True, coulomb=True, armature=True, offset=offset)
+    theta = extended_parameters(m, damping=True, coulomb=True, armature=True, offset=offset)
     C = rd.coriolis_matrix(m, q, v)
     assert_rel(Y @ theta, rd.rnea(m, q, v, a_r) - np.einsum("...ij,...j->...i", C, v - v_r) + offset, 1e-10)
     assert_rel(Y[..., :10 * nb], rd.slotine_li_regressor(m, q, v, v_r, a_r), 0.0)
@@ -151,7 +151,7 @@ def test_robot_without_joints():
     model = b.build()
     z = np.zeros(0)
     assert rd.slotine_li_regressor(model, z, z, z, z).shape == (0, 0)
-    assert rd.slotine_li_regressor(model, np.zeros((3, 0)), z, z, z, viscous=True).shape == (3, 0, 0)
+    assert rd.slotine_li_regressor(model, np.zeros((3, 0)), z, z, z, damping=True).shape == (3, 0, 0)
 
 
 @input_checks

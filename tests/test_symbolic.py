@@ -61,7 +61,7 @@ def test_generated_function_checks_shapes(derived):
     model, eom, f = derived["planar_2r"]
     with pytest.raises(ValueError, match=r"q: expected shape \(\.\.\., 2\), got \(3,\)"):
         f["M"](np.zeros(3))
-    with pytest.raises(ValueError, match=r"qd: expected shape \(\.\.\., 2\)"):
+    with pytest.raises(ValueError, match=r"v: expected shape \(\.\.\., 2\)"):
         f["C"](np.zeros(2), np.zeros(5))
 
 
@@ -112,7 +112,7 @@ def test_c_code_compiles_and_matches(derived, name, tmp_path):
 
 # -- generated code of the recursions -------------------------------------------------------
 ALL_ROBOTS = SMALL_ROBOTS + ["panda"]
-RECURSIVE_TERMS = ("M", "C_qd", "g", "tau")
+RECURSIVE_TERMS = ("M", "C_v", "g", "tau")
 
 
 @pytest.fixture(scope="module")
@@ -127,14 +127,14 @@ def recursive():
 
 
 def numeric_terms(model, q, v, a):
-    """The recursive terms by the numeric kernels: M, C qd, g, tau."""
+    """The recursive terms by the numeric kernels: M, C v, g, tau."""
     g = rd.gravity(model, q)
-    return {"M": rd.crba(model, q), "C_qd": rd.rnea(model, q, v, 0 * v, friction=False) - g, "g": g,
+    return {"M": rd.crba(model, q), "C_v": rd.rnea(model, q, v, 0 * v, friction=False) - g, "g": g,
             "tau": rd.rnea(model, q, v, a, friction=False)}
 
 
 def inputs(term, q, v, a):
-    return {"M": (q,), "C_qd": (q, v), "g": (q,), "tau": (q, v, a)}[term]
+    return {"M": (q,), "C_v": (q, v), "g": (q,), "tau": (q, v, a)}[term]
 
 
 @pytest.mark.parametrize("name", ALL_ROBOTS)
@@ -179,9 +179,9 @@ def test_recursive_numba_inputs(recursive):
     assert_rel(tau(q, v, a), expected["tau"], 1e-12, "tau")
     q0, v0 = np.broadcast_to(q[0], q.shape), np.broadcast_to(v[0], v.shape)
     assert_rel(tau(q[0], v[0], a), rd.rnea(model, q0, v0, a, friction=False), 1e-12, "tau, broadcast")
-    with pytest.raises(ValueError, match=r"qdd: expected shape \(\.\.\., 4\), got \(3,\)"):
+    with pytest.raises(ValueError, match=r"a: expected shape \(\.\.\., 4\), got \(3,\)"):
         tau(q[0], v[0], a[0, :3])
-    assert_rel(rec.to_numba("C_qd")(q[2], v[2]), expected["C_qd"][2], 1e-12, "C_qd, one state")
+    assert_rel(rec.to_numba("C_v")(q[2], v[2]), expected["C_v"][2], 1e-12, "C_v, one state")
 
 
 @pytest.mark.parametrize("name", ["puma560", "panda"])
@@ -270,9 +270,9 @@ def spherical_pendulum():
     q2 = polar angle theta from the downward vertical (about the turned y axis)."""
     m, l = sp.symbols("m l", positive=True)
     return S.SymbolicModel(
-        parent=(-1, 0), joint_type=("revolute", "revolute"), axis=([0, 0, 1], [0, 1, 0]),
-        R_tree=(sp.eye(3), sp.eye(3)), p_tree=([0, 0, 0], [0, 0, 0]),
-        inertia=([0] * 10, S.inertial_parameters(m, [0, 0, -l], sp.zeros(3))),
+        parent=(-1, 0), joint_type=("revolute", "revolute"), joint_axis=([0, 0, 1], [0, 1, 0]),
+        X_tree_R=(sp.eye(3), sp.eye(3)), X_tree_p=([0, 0, 0], [0, 0, 0]),
+        theta=([0] * 10, S.inertial_parameters(m, [0, 0, -l], sp.zeros(3))),
         gravity=[0, 0, -g], name="spherical_pendulum"), m, l
 
 
@@ -318,7 +318,7 @@ def test_lagrange_and_newton_euler_agree(name):
     model = routes_models()[name]
     lag = S.equations_of_motion(model, "lagrange")
     ne = S.equations_of_motion(model, "newton_euler")
-    for term in ("M", "C", "C_qd", "g", "T", "U", "tau"):
+    for term in ("M", "C", "C_v", "g", "T", "U", "tau"):
         assert lag.equals(ne, term), term
         assert is_zero(lag.term(term) - ne.term(term)), term
     assert lag.parameters and lag.parameters == ne.parameters
@@ -330,12 +330,12 @@ def test_christoffel_matrix_properties(method):
     M, C = eom.M, eom.C
     Mdot = sp.zeros(2, 2)
     for k in range(2):
-        Mdot += M.diff(eom.q[k]) * eom.qd[k]
+        Mdot += M.diff(eom.q[k]) * eom.v[k]
     N = Mdot - 2 * C
     assert is_zero(N + N.T)
-    qd = sp.Matrix(eom.qd)
-    assert is_zero(C * qd - eom.C_qd)
-    qdd = sp.Matrix(eom.qdd)
+    qd = sp.Matrix(eom.v)
+    assert is_zero(C * qd - eom.C_v)
+    qdd = sp.Matrix(eom.a)
     assert is_zero(M * qdd + C * qd + eom.g - eom.tau)
     assert is_zero(eom.L - (eom.T - eom.U))
     assert is_zero(eom.T - (qd.T * M * qd)[0] / 2)
@@ -347,8 +347,8 @@ def test_spherical_pendulum_equations(method):
     model, m, l = spherical_pendulum()
     eom = S.equations_of_motion(model, method)
     phi, th = eom.q
-    phid, thd = eom.qd
-    phidd, thdd = eom.qdd
+    phid, thd = eom.v
+    phidd, thdd = eom.a
     expected = sp.Matrix([
         m * l**2 * sp.sin(th) ** 2 * phidd + 2 * m * l**2 * sp.sin(th) * sp.cos(th) * thd * phid,
         m * l**2 * thdd - m * l**2 * sp.sin(th) * sp.cos(th) * phid**2 + m * g * l * sp.sin(th),
@@ -363,7 +363,7 @@ def test_two_link_planar_arm(method):
     model, (m1, m2, Iz1, Iz2) = planar_2r_symbolic()
     eom = S.equations_of_motion(model, method)
     q1, q2 = eom.q
-    qd1, qd2 = eom.qd
+    qd1, qd2 = eom.v
     alpha = Iz1 + Iz2 + m1 * r1**2 + m2 * (l1**2 + r2**2)
     beta = m2 * l1 * r2
     delta = Iz2 + m2 * r2**2

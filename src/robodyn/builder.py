@@ -334,7 +334,7 @@ class ModelBuilder:
         return Model(
             parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)), joint_pitch=pitch,
             X_tree_R=np.reshape(XR, (nb, 3, 3)), X_tree_p=np.reshape(Xp, (nb, 3)),
-            inertia=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
+            theta=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
             gravity=self.gravity, lower=col("lower"), upper=col("upper"),
             velocity_limit=col("velocity"), effort_limit=col("effort"), damping=col("damping"),
             coulomb=col("friction"), armature=col("armature"),

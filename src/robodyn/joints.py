@@ -56,18 +56,15 @@ Q_COMPONENTS = ((), (), ("x", "y", "z", "qx", "qy", "qz", "qw"), ("qx", "qy", "q
 V_COMPONENTS = ((), (), ("vx", "vy", "vz", "wx", "wy", "wz"), ("wx", "wy", "wz"), (), ("vx", "vy", "wz"))
 
 
-def coordinate_names(joint_types, joint_names, kind: str = "v", sep: str = "[") -> list[str]:
+def coordinate_names(joint_types, joint_names, kind: str = "v") -> list[str]:
     """One name per entry of ``v`` (``kind="v"``) or ``q`` (``"q"``): the joint's name, or
-    ``name[vx]``, ``name[wx]`` ... (``sep="["``) / ``name:vx`` (``sep=":"``) for the entries
-    of a free or spherical joint."""
+    ``name:vx``, ``name:wx`` ... for the entries of a multi-dof joint (``Model.dof_names``,
+    ``Model.q_names``)."""
     parts = V_COMPONENTS if kind == "v" else Q_COMPONENTS
     out = []
     for jt, name in zip(joint_types, joint_names):
         comps = parts[int(jt)]
-        if not comps:
-            out.append(name)
-        else:
-            out.extend(f"{name}[{c}]" if sep == "[" else f"{name}{sep}{c}" for c in comps)
+        out.extend(f"{name}:{c}" for c in comps) if comps else out.append(name)
     return out
 
 

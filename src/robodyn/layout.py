@@ -91,7 +91,7 @@ def pack(model) -> KernelTables:
     body[:, XTREE_R:XTREE_R + 9] = model.X_tree_R.reshape(nb, 9)
     body[:, XTREE_P:XTREE_P + 3] = model.X_tree_p
     body[:, JOINT_AXIS:JOINT_AXIS + 3] = model.joint_axis
-    body[:, INERTIA:INERTIA_END] = model.inertia
+    body[:, INERTIA:INERTIA_END] = model.theta
     for i in range(nb):
         body[i, JOINT_CONSTANTS:] = J.joint_constants(int(model.joint_type[i]), model.joint_axis[i],
                                                       model.X_tree_R[i], model.joint_pitch[i])

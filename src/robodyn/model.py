@@ -21,6 +21,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ._deprecated import renamed_attribute, renamed_keyword
 from . import joints as J
 
 
@@ -144,7 +145,8 @@ class Model:
     Per-body arrays (``nb = nbodies``): ``parent`` (nb,), ``joint_type`` (nb,),
     ``joint_axis`` (nb, 3), ``joint_pitch`` (nb,) (metres per radian, helical joints only),
     ``X_tree_R`` (nb, 3, 3) and ``X_tree_p`` (nb, 3) (joint frame in the parent body frame),
-    ``inertia`` (nb, 10), ``idx_q`` (nb,), ``idx_v`` (nb,).
+    ``theta`` (nb, 10) the inertial parameters of each body (``Model.inertial_parameters``
+    order), ``idx_q`` (nb,), ``idx_v`` (nb,).
     Per-dof arrays (nv,): ``lower``, ``upper`` (position limits of 1-dof joints, +-inf for free
     joints), ``velocity_limit``, ``effort_limit``, ``damping`` (viscous, N m s/rad), ``coulomb``
     (N m), ``armature`` (reflected rotor inertia, kg m^2). Frames (nf): ``frame_names``,
@@ -153,7 +155,7 @@ class Model:
     """
 
     __slots__ = (
-        "name", "parent", "joint_type", "joint_axis", "joint_pitch", "X_tree_R", "X_tree_p", "inertia",
+        "name", "parent", "joint_type", "joint_axis", "joint_pitch", "X_tree_R", "X_tree_p", "theta",
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
         "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
@@ -168,7 +170,7 @@ class Model:
         joint_axis,
         X_tree_R,
         X_tree_p,
-        inertia,
+        theta=None,
         link_names: Sequence[str],
         body_joint_names: Sequence[str],
         gravity=(0.0, 0.0, -9.81),
@@ -187,7 +189,12 @@ class Model:
         joint_pitch=None,
         name: str = "robot",
         physical: str = "error",
+        inertia=None,
     ):
+        if inertia is not None:  # the old spelling of ``theta``
+            theta = renamed_keyword("inertia", inertia, "theta", theta, "Model()", default=None)
+        if theta is None:
+            raise TypeError("Model() missing the keyword argument 'theta' (nb, 10)")
         setattr_ = object.__setattr__
         parent = np.asarray(parent, dtype=np.int64).reshape(-1)
         nb = parent.shape[0]
@@ -223,7 +230,7 @@ class Model:
             raise ModelError(f"body {i}: joint_pitch {pitch[i]} on a {J.NAMES[jt[i]]} joint (only helical joints have one)")
         R = arr(X_tree_R, (nb, 3, 3), "X_tree_R")
         p = arr(X_tree_p, (nb, 3), "X_tree_p")
-        theta = arr(inertia, (nb, 10), "inertia")
+        theta = arr(theta, (nb, 10), "theta")
         names = list(link_names)
         jnames = list(body_joint_names)
         if len(names) != nb or len(jnames) != nb:
@@ -305,7 +312,7 @@ class Model:
         setattr_(self, "joint_pitch", _readonly(pitch))
         setattr_(self, "X_tree_R", _readonly(R))
         setattr_(self, "X_tree_p", _readonly(p))
-        setattr_(self, "inertia", _readonly(theta))
+        setattr_(self, "theta", _readonly(theta))
         setattr_(self, "idx_q", _readonly(idx_q, np.int64))
         setattr_(self, "idx_v", _readonly(idx_v, np.int64))
         setattr_(self, "nq", nq)
@@ -343,24 +350,43 @@ class Model:
         return bool(self.nbodies and self.joint_type[0] == J.FREE)
 
     @property
+    def q_names(self) -> list[str]:
+        """One name per entry of ``q`` (nq): the joint's name, or ``<joint>:x``, ``:y``, ``:z``,
+        ``:qx``, ``:qy``, ``:qz``, ``:qw`` for a free joint (``:qx`` ... ``:qw`` spherical,
+        ``:x``, ``:y``, ``:c``, ``:s`` planar). The names of every file column and report."""
+        return J.coordinate_names(self.joint_type, self.body_joint_names, "q")
+
+    @property
+    def dof_names(self) -> list[str]:
+        """One name per entry of ``v``, ``a`` and ``tau`` (nv): the joint's name, or
+        ``<joint>:vx``, ``:vy``, ``:vz``, ``:wx``, ``:wy``, ``:wz`` for a free joint (``:wx`` ...
+        spherical, ``:vx``, ``:vy``, ``:wz`` planar)."""
+        return J.coordinate_names(self.joint_type, self.body_joint_names, "v")
+
+    @property
     def total_mass(self) -> float:
-        return float(self.inertia[:, 0].sum())
+        return float(self.theta[:, 0].sum())
 
     def inertial_parameters(self) -> np.ndarray:
         """All inertial parameters, (10 * nbodies,), body after body (order in module doc)."""
-        return self.inertia.reshape(-1).copy()
+        return self.theta.reshape(-1).copy()
 
     def with_inertial_parameters(self, theta) -> "Model":
         """A new model with the inertial parameters ``theta`` (10 * nbodies,)."""
         theta = np.asarray(theta, dtype=float)
         if theta.shape != (10 * self.nbodies,):
             raise ValueError(f"theta: expected shape ({10 * self.nbodies},), got {theta.shape}")
-        return self.replace(inertia=theta.reshape(self.nbodies, 10))
+        return self.replace(theta=theta.reshape(self.nbodies, 10))
+
+    inertia = renamed_attribute("inertia", "theta")  # ``inertia`` names 3 x 3 matrices in robodyn
 
     def replace(self, **changes) -> "Model":
         """A new model with some constructor arguments changed (validated again)."""
+        if "inertia" in changes:  # the old spelling of ``theta``
+            changes["theta"] = renamed_keyword("inertia", changes.pop("inertia"), "theta", changes.get("theta"),
+                                               "Model.replace()", default=None)
         kw = {k: getattr(self, k) for k in (
-            "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "link_names",
+            "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta", "link_names",
             "body_joint_names", "gravity", "lower", "upper", "velocity_limit", "effort_limit",
             "damping", "coulomb", "armature", "coulomb_smoothing", "frame_names", "frame_body",
             "frame_R", "frame_p", "name", "physical", "joint_pitch")}
@@ -405,7 +431,7 @@ class Model:
             ax = "" if J.NQ[self.joint_type[i]] > 1 else np.array2string(self.joint_axis[i], precision=3, suppress_small=True)
             lines.append(
                 f"  {i:>3} {self.link_names[i]:<24} {self.body_joint_names[i]:<24} "
-                f"{J.NAMES[self.joint_type[i]]:<9} {par:<20} {ax:<22} {self.inertia[i, 0]:>9.4g}"
+                f"{J.NAMES[self.joint_type[i]]:<9} {par:<20} {ax:<22} {self.theta[i, 0]:>9.4g}"
             )
         if self.frame_names:
             lines.append(f"  frames: {', '.join(self.frame_names)}")

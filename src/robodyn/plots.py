@@ -53,12 +53,6 @@ def _save(fig, path) -> None:
             fig.savefig(tmp, dpi=100)
 
 
-def _dof_labels(model) -> list[str]:
-    from .io.trajectory_csv import coordinate_names
-
-    return coordinate_names(model)[1]
-
-
 def plot_torques(model, t, q, v, a, path=None) -> dict:
     """One panel per joint: inertial, Coriolis/centrifugal, gravity and total joint force
     over time. Returns ``{"t", "inertial", "coriolis", "gravity", "total"}``."""
@@ -67,7 +61,7 @@ def plot_torques(model, t, q, v, a, path=None) -> dict:
     cols = 1 if nv <= 3 else 2
     rows = -(-nv // cols)
     fig, axes = _figure(rows, cols, size=(6.0, 2.4))
-    labels = _dof_labels(model)
+    labels = model.dof_names
     for k in range(nv):
         ax = axes[k // cols, k % cols]
         for key, style in (("inertial", "-"), ("coriolis", "--"), ("gravity", ":"), ("total", "-")):
@@ -88,7 +82,7 @@ def plot_torques(model, t, q, v, a, path=None) -> dict:
 
 def _draw_trajectory(ax_q, ax_e, traj) -> dict:
     data = dict(t=traj.t, q=traj.q, q_desired=traj.q_desired, error=traj.tracking_error)
-    names = _dof_labels(traj.model) if traj.model.nq == traj.model.nv else [f"q[{k}]" for k in range(traj.model.nq)]
+    names = traj.model.q_names
     for k in range(traj.q.shape[1]):
         line, = ax_q.plot(traj.t, traj.q[:, k], label=names[k])
         if traj.q_desired is not None:

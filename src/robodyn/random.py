@@ -71,7 +71,7 @@ def random_model(nbodies: int, seed: int = 0, floating_base: bool = False, branc
     names = [f"body{i}" for i in range(nb)]
     jnames = ["root_joint" if jtype[i] == J.FREE else f"joint{i}" for i in range(nb)]
     return Model(parent=parent, joint_type=jtype, joint_axis=np.array(axis), joint_pitch=pitch, X_tree_R=np.array(XR),
-                 X_tree_p=np.array(Xp), inertia=np.array(theta), link_names=names,
+                 X_tree_p=np.array(Xp), theta=np.array(theta), link_names=names,
                  body_joint_names=jnames, gravity=gravity, name=f"random{nbodies}-seed{seed}")
 
 

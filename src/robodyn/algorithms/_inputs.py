@@ -123,7 +123,7 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
         return (zero if batch == () else zero[None]), -1
     codes = WRENCH_FRAMES
     if frame not in codes:
-        raise ValueError(f"f_ext_frame must be one of {sorted(codes)}, got {frame!r}")
+        raise ValueError(f"frame must be one of {sorted(codes)}, got {frame!r}")
     nb = model.nbodies
     f = _as_float("f_ext", f_ext)
     if f.ndim < 2 or f.shape[-2:] != (nb, 6):

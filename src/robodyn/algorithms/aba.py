@@ -34,6 +34,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
+from .._deprecated import renamed_keyword
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import friction_torque, local_placement
@@ -550,14 +551,15 @@ def _aba_packed(ints, packed, q, v, tau, check, qdd):
                    workspace(ints.shape[0], dofs.shape[0]))
 
 
-def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-        armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
+def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = True,
+        armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None,
+        f_ext_frame=None) -> np.ndarray:
     """Forward dynamics: the acceleration produced by joint forces ``tau`` at ``(q, v)``.
 
     ``a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)``
 
     Args:
-        q: (..., nq). v, tau: (..., nv). f_ext, f_ext_frame, friction, armature,
+        q: (..., nq). v, tau: (..., nv). f_ext, frame, friction, armature,
         check_finite, out: as in :func:`robodyn.rnea`.
 
     Returns:
@@ -566,8 +568,10 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
     Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
     leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
     """
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba()")
     k = model.kernel
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
             if _aba_packed(k.ints, k.packed[friction, armature], q, v, tau, check_finite, qdd) == OK:
@@ -575,7 +579,7 @@ def aba(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: b
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     qdd, result = _inputs.output(out, batch, (model.nv,), x)
     if batch == ():

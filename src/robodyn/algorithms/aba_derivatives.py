@@ -23,6 +23,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
+from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from . import _inputs
 from . import rnea as _rnea
@@ -130,8 +131,9 @@ def _derivatives_packed(ints, packed, q, v, tau, check, da_dq, da_dv, Minv):
                            workspace(ints.shape[0], nv))
 
 
-def aba_derivatives(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-                    armature: bool = True, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = True,
+                    armature: bool = True, check_finite: bool = True,
+                    f_ext_frame=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Partial derivatives of forward dynamics, ``qdd = aba(q, v, tau, f_ext)``, analytical.
 
     ``dqdd_dq = -M^-1 dtau_dq``, ``dqdd_dv = -M^-1 dtau_dv`` (the derivatives of
@@ -140,7 +142,7 @@ def aba_derivatives(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *,
     ``computeABADerivatives``.
 
     Args:
-        q: (..., nq). v, tau: (..., nv). f_ext, f_ext_frame, friction, armature, check_finite:
+        q: (..., nq). v, tau: (..., nv). f_ext, frame, friction, armature, check_finite:
             as in :func:`robodyn.aba`.
 
     Returns:
@@ -149,13 +151,15 @@ def aba_derivatives(model, q, v, tau, f_ext=None, f_ext_frame: str = "local", *,
     Raises ValueError when a body's articulated inertia is singular, as :func:`robodyn.aba`.
     Reference: Carpentier and Mansard, RSS 2018.
     """
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba_derivatives()")
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         out = _rd.fast_path(_derivatives_packed, model, q, v, tau, friction, armature, check_finite)
         if out is not None:
             return out
     k, nv = model.kernel, model.nv
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     (dq, rq), (dv, rv), (Mi, rM) = (_inputs.output(None, batch, (nv, nv), x) for _ in range(3))
     args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, dq, dv, Mi)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._deprecated import renamed_keyword
 from .._jit import inline, kernel
 from .. import joints as J
 from . import _inputs
@@ -72,9 +73,9 @@ def known_dofs(model, known_mask) -> np.ndarray:
     return np.ascontiguousarray(mask)
 
 
-def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_ext_frame: str = "local", *,
+def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, frame: str = "local", *,
                     friction: bool = True, armature: bool = True,
-                    check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
+                    check_finite: bool = True, f_ext_frame=None) -> tuple[np.ndarray, np.ndarray]:
     """Hybrid dynamics: given the accelerations of some joints and the forces of the others,
     the missing forces and accelerations.
 
@@ -90,7 +91,7 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
             six entries True (its acceleration ``[a_lin; alpha]`` in the base frame is given,
             its wrench computed) or all six False (its wrench ``[force; torque]`` in the base
             frame is given, usually zero, and its acceleration computed).
-        f_ext, f_ext_frame, friction, armature, check_finite: as in :func:`robodyn.rnea`.
+        f_ext, frame, friction, armature, check_finite: as in :func:`robodyn.rnea`.
             Entries that are not read may be NaN.
 
     Returns:
@@ -102,16 +103,18 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, f_e
     whose acceleration is unknown is singular. Reference: Featherstone, RBDA (2008),
     section 9.2.
     """
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "hybrid_dynamics()")
     known = known_dofs(model, known_mask)
     k = model.kernel
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
         a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
         if _hybrid_single(k.ints, k.body, dofs, params, q, v, a_known, tau_known, known, k.zero_wrench,
                           -1, check_finite, a, tau) == OK:
             return a, tau
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
             check_finite)
     if batch == ():

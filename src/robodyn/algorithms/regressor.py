@@ -23,7 +23,7 @@ and Control of Robots* (2002), section 12.3 (Newton-Euler form of the identifica
 Optional columns of the joint-torque regressor, appended after the ``10 nb`` inertial columns
 in this order, ``nv`` columns each (column ``k`` of a block acts on dof ``k`` only):
 
-    viscous    v_k                 (parameter: ``model.damping[k]``)
+    damping    v_k                 (parameter: ``model.damping[k]``, viscous friction)
     coulomb    sgn(v_k)            (``model.coulomb[k]``; ``tanh(v_k / eps)`` when
                                     ``model.coulomb_smoothing = eps > 0``, as in ``rnea``)
     armature   a_k                 (``model.armature[k]``)
@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._deprecated import renamed_keywords
 from .._jit import core, inline, kernel
 from ..layout import IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
@@ -52,7 +53,7 @@ from .kinematics import poses_checked
 from .rnea import base_acceleration, motion_pass
 from .driver import batch_kernel, chunks
 
-EXTRA_COLUMNS = ("viscous", "coulomb", "armature", "offset")
+EXTRA_COLUMNS = ("damping", "coulomb", "armature", "offset")
 # The flags of the extra columns follow the model's ``params`` in the kernels' ``params``.
 EXTRA_FLAGS = PARAMS_SIZE
 
@@ -290,29 +291,23 @@ def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
     return energy_regressor_one(ints, body, dofs, grav, q, v, check, out, workspace(ints.shape[0], dofs.shape[0]))
 
 
-def extra_columns(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+@renamed_keywords(viscous="damping")
+def extra_columns(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
                   offset: bool = False) -> list[str]:
-    """Names of the extra regressor columns, in order: ``"viscous[joint]"``, ... one per dof."""
-    names = dof_names(model)
-    flags = dict(viscous=viscous, coulomb=coulomb, armature=armature, offset=offset)
+    """Names of the extra regressor columns, in order: ``"damping[joint]"``, ... one per dof."""
+    names = model.dof_names
+    flags = dict(damping=damping, coulomb=coulomb, armature=armature, offset=offset)
     return [f"{kind}[{n}]" for kind in EXTRA_COLUMNS if flags[kind] for n in names]
 
 
-def dof_names(model) -> list[str]:
-    """One name per entry of ``v``: the joint name, or ``name[vx]`` ... for a free joint
-    (``name[wx]`` ... for a spherical joint)."""
-    from ..joints import coordinate_names
-
-    return coordinate_names(model.joint_type, model.body_joint_names)
-
-
-def extended_parameters(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+@renamed_keywords(viscous="damping")
+def extended_parameters(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
                         offset=None) -> np.ndarray:
     """The parameter vector that matches :func:`regressor` with the same switches:
     ``[theta, damping, coulomb, armature, offset]`` (blocks present when switched on;
     ``offset`` is an (nv,) array of joint torque offsets, or None for no offset columns)."""
     parts = [model.inertial_parameters()]
-    for on, values in ((viscous, model.damping), (coulomb, model.coulomb), (armature, model.armature)):
+    for on, values in ((damping, model.damping), (coulomb, model.coulomb), (armature, model.armature)):
         if on:
             parts.append(np.asarray(values, dtype=float))
     if offset is not None:
@@ -323,7 +318,8 @@ def extended_parameters(model, *, viscous: bool = False, coulomb: bool = False, 
     return np.concatenate(parts)
 
 
-def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+@renamed_keywords(viscous="damping")
+def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
               offset: bool = False, check_finite: bool = True) -> np.ndarray:
     """Joint-torque regressor ``Y`` with ``Y @ model.inertial_parameters() == rnea(model, q, v,
     a, friction=False, armature=False)``.
@@ -333,7 +329,7 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
 
     Args:
         q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
-        viscous, coulomb, armature, offset: append ``nv`` columns each, in this order, for
+        damping, coulomb, armature, offset: append ``nv`` columns each, in this order, for
             viscous friction (``v_k``), Coulomb friction (``sgn v_k``, smoothed as in ``rnea``
             when ``model.coulomb_smoothing > 0``), armature (``a_k``) and a constant joint
             torque offset (``1``); see :func:`extended_parameters` and :func:`extra_columns`.
@@ -347,7 +343,7 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
     """
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     k = model.kernel
-    flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
+    flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
     params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
@@ -363,7 +359,8 @@ def regressor(model, q, v, a, *, viscous: bool = False, coulomb: bool = False, a
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
 
-def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, coulomb: bool = False,
+@renamed_keywords(viscous="damping")
+def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, coulomb: bool = False,
                          armature: bool = False, offset: bool = False, check_finite: bool = True) -> np.ndarray:
     """Slotine-Li regressor ``Y(q, qd, qd_r, qdd_r)``, linear in the inertial parameters::
 
@@ -386,7 +383,7 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, co
     Args:
         q: (..., nq) configuration. v: (..., nv) velocity ``qd``. v_ref, a_ref: (..., nv)
             reference velocity ``qd_r`` and acceleration ``qdd_r``.
-        viscous, coulomb, armature, offset: extra ``nv``-column blocks as in :func:`regressor`,
+        damping, coulomb, armature, offset: extra ``nv``-column blocks as in :func:`regressor`,
             evaluated at ``(v, a_ref)``: ``v_k``, ``sgn v_k``, ``qdd_r,k``, ``1``; with them,
             ``Y @ extended_parameters(model, ...) == rnea(q, v, a_ref) - C(q, v) (v - v_ref)``
             (+ offset): the friction of the true velocity and the armature at ``qdd_r``.
@@ -402,7 +399,7 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, viscous: bool = False, co
     """
     batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
     k = model.kernel
-    flags = [float(bool(f)) for f in (viscous, coulomb, armature, offset)]
+    flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
     params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     args = (k.ints, k.body, k.dofs[(False, False)], params)

@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
+from .._deprecated import renamed_keyword
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import body_placement, friction_torque
@@ -231,8 +232,9 @@ def external_wrenches(model, f_ext, frame: str = "local") -> tuple[np.ndarray, n
     return F, np.int64(code)
 
 
-def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-         armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
+def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = True,
+         armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None,
+         f_ext_frame=None) -> np.ndarray:
     """Inverse dynamics: the joint forces that produce acceleration ``a`` at state ``(q, v)``.
 
     ``tau = M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i + armature * a + friction(v)``
@@ -240,7 +242,7 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     Args:
         q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
         f_ext: optional (..., nbodies, 6) external wrenches ``[force, torque]`` applied to each
-            body, expressed in ``f_ext_frame``: ``"local"`` (body frame, torque about the body
+            body, expressed in ``frame``: ``"local"`` (body frame, torque about the body
             origin), ``"world"`` (world axes, torque about the world origin) or
             ``"local_world_aligned"`` (world axes, torque about the body origin).
         friction: add the model's joint friction ``damping v + coulomb sgn(v)``.
@@ -257,7 +259,9 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
     nonlinear_effects(q, v)``, ``rnea(q, v, a) == crba(q) a + nonlinear_effects(q, v)`` without
     friction. Reference: Featherstone, RBDA (2008), Table 5.1.
     """
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea()")
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         k = model.kernel  # fast path for one state: the kernel checks sizes and values
         tau = _inputs.fast_out(out, (model.nv,))
         try:
@@ -266,5 +270,5 @@ def rnea(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bo
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
     batch, x = _inputs.states(model, q=q, v=v, a=a)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)

@@ -53,6 +53,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
+from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, COULOMB, DAMPING, IV, NDOF, PARENT, SMOOTHING, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
@@ -374,8 +375,9 @@ def fast_path(packed, model, q, v, x, friction, armature, check):
     return None
 
 
-def rnea_derivatives(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, friction: bool = True,
-                     armature: bool = True, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def rnea_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = True,
+                     armature: bool = True, check_finite: bool = True,
+                     f_ext_frame=None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Partial derivatives of inverse dynamics, ``tau = rnea(q, v, a, f_ext)``, analytical, O(n d).
 
     ``dtau_dq[:, k] = d tau(q ⊕ eps e_k, v, a) / d eps`` at 0 (the tangent direction of
@@ -385,7 +387,7 @@ def rnea_derivatives(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, 
     armature when ``armature``), the same derivatives as Pinocchio's ``computeRNEADerivatives``.
 
     Args:
-        q: (..., nq). v, a: (..., nv). f_ext, f_ext_frame, friction, armature, check_finite:
+        q: (..., nq). v, a: (..., nv). f_ext, frame, friction, armature, check_finite:
             as in :func:`robodyn.rnea` (wrenches in the body frame turn with their body; in
             world axes they keep their direction).
 
@@ -395,12 +397,14 @@ def rnea_derivatives(model, q, v, a, f_ext=None, f_ext_frame: str = "local", *, 
     Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
     algorithms", RSS 2018 (the recursions are in ``robodyn/algorithms/rnea_derivatives.py``).
     """
-    if f_ext is None and f_ext_frame in _inputs.WRENCH_FRAMES:
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea_derivatives()")
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         out = fast_path(_derivatives_packed, model, q, v, a, friction, armature, check_finite)
         if out is not None:
             return out
     batch, x = _inputs.states(model, q=q, v=v, a=a)
-    F, fcode = _inputs.body_wrenches(model, f_ext, batch, f_ext_frame)
+    F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)
 
 

@@ -25,7 +25,7 @@ def cmd_excite(args) -> int:
 
     check_output_file(args.out, "--out")
     model = _model(args)
-    base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction)
+    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction)
     period = args.period if args.period is not None else args.duration
     lim = limits_of(model, acceleration=args.acceleration)
     print(f"{model.name}: {base.count} base parameters; optimising {args.harmonics} harmonics over "
@@ -49,8 +49,8 @@ def cmd_identify(args) -> int:
     check_output_file(args.out, "--out")
     check_output_dir(args.report, "--report")
     model = _model(args)
-    log = preprocess(read_log(args.data, model), cutoff=args.cutoff, decimate=args.decimate)
-    base = base_parameters(model, viscous=not args.no_friction, coulomb=not args.no_friction, offset=args.offset)
+    log = preprocess(read_log(args.data, model, require_tau=True), cutoff=args.cutoff, decimate=args.decimate)
+    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction, offset=args.offset)
     result = identify(model, log, method=args.method, base=base)
     print(result.summary())
     if args.out:
@@ -79,7 +79,8 @@ def add_commands(sub) -> None:
     p.set_defaults(func=cmd_excite)
     p = sub.add_parser("identify", help="identify inertial parameters and friction from a CSV log")
     add_model_arguments(p)
-    p.add_argument("data", type=Path, help="CSV log: time, q_<joint>, [qd_<joint>, qdd_<joint>,] tau_<joint>")
+    p.add_argument("data", type=Path, help="log (CSV, or Parquet for .parquet): t, q:<joint>, [v:<joint>, a:<joint>,] "
+                                             "tau:<joint>, as written by simulate --csv")
     p.add_argument("--method", choices=("ols", "wls", "physical"), default="ols")
     p.add_argument("--out", type=Path, help="identified model as URDF")
     p.add_argument("--report", type=Path, help="directory for report.txt and plots")

@@ -29,7 +29,7 @@ def cmd_info(args) -> int:
     print("\nInertial parameters per body (about the body origin, body frame):")
     print(f"  {'body':<24} {'m':>9} {'mcx':>9} {'mcy':>9} {'mcz':>9} {'Ixx':>9} {'Ixy':>9} {'Iyy':>9} {'Ixz':>9} {'Iyz':>9} {'Izz':>9}")
     for i, name in enumerate(model.link_names):
-        print(f"  {name:<24} {_fmt(model.inertia[i])}")
+        print(f"  {name:<24} {_fmt(model.theta[i])}")
     if model.nv:
         print("\nJoint data (per velocity entry):")
         print(f"  {'#':>3} {'lower':>9} {'upper':>9} {'vel.max':>9} {'effort':>9} {'damping':>9} {'coulomb':>9} {'armature':>9}")
@@ -72,7 +72,7 @@ def cmd_demo(args) -> int:
     tau = rd.rnea(model, q, v, a, friction=False, armature=False)
     print("\nInverse dynamics (RNEA): tau = M(q) qdd + C(q, qd) qd + g(q)   [N m or N]")
     print(f"  {'joint':<22} {'inertial':>10} {'coriolis':>10} {'gravity':>10} {'total':>10}")
-    names = _dof_names(model)
+    names = model.dof_names
     for k in range(model.nv):
         print(f"  {names[k]:<22} {inertial[k]:10.4f} {coriolis[k]:10.4f} {grav[k]:10.4f} {tau[k]:10.4f}")
     residual = np.abs(inertial + coriolis + grav - tau).max()
@@ -90,12 +90,6 @@ def cmd_demo(args) -> int:
     print(f"\nKinetic energy {rd.kinetic_energy(model, q, v):.6f} J, "
           f"potential energy {rd.potential_energy(model, q):.6f} J")
     return 0
-
-
-def _dof_names(model) -> list[str]:
-    from ..joints import coordinate_names
-
-    return coordinate_names(model.joint_type, model.body_joint_names)
 
 
 def cmd_bench(args) -> int:

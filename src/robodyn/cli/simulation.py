@@ -13,7 +13,7 @@ tracks a quintic from ``q0`` to the target in the first half of the run, or the 
 of a CSV file given with ``--reference`` (interpolated by a cubic spline). The gains follow
 from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
 so that light wrist joints do not make the closed loop too stiff for the fixed step). ``--csv`` writes
-the trajectory in the format of :mod:`robodyn.io.trajectory_csv`, which ``torques``
+the trajectory in robodyn's tabular format (:mod:`robodyn.io.log`), which ``torques``
 reads (or any CSV with a ``t`` column and ``q:<joint>`` columns) to plot the joint forces
 split into inertial, Coriolis/centrifugal and gravity parts.
 
@@ -185,9 +185,9 @@ def cmd_simulate(args) -> int:
         raise ValueError("--reference applies to --controller computed-torque")
     q_start = _vector(args.q0, model.nq, "--q0")
     if args.reference and q_start is None:
-        from ..io.trajectory_csv import read_csv
+        from ..io.log import read_trajectory
 
-        q_start = read_csv(model, args.reference)[1][0]
+        q_start = read_trajectory(args.reference, model)[1][0]
     q0, target = start_and_target(model, q_start, _vector(args.target, model.nv, "--target"))
     if contacts is not None and q_start is None:
         if not (np.isfinite(args.drop) and args.drop >= 0):
@@ -256,15 +256,15 @@ def cmd_simulate(args) -> int:
 
 def cmd_torques(args) -> int:
     from ..plots import plot_torques
-    from ..io.trajectory_csv import coordinate_names, read_csv
+    from ..io.log import read_trajectory
 
     check_output_file(args.plot, "--plot")
     model = load_model(args.model, args.floating_base, args.physical)
-    t, q, v, a = read_csv(model, args.trajectory)
+    t, q, v, a = read_trajectory(args.trajectory, model)
     data = save(lambda path: plot_torques(model, t, q, v, a, path), args.plot, "--plot")
     print(f"robodyn torques {model.name!r}: {t.shape[0]} samples from {args.trajectory}")
     print(f"  {'joint':<24} {'max|inertial|':>14} {'max|coriolis|':>14} {'max|gravity|':>14} {'max|total|':>14}")
-    for k, name in enumerate(coordinate_names(model)[1]):
+    for k, name in enumerate(model.dof_names):
         vals = [np.abs(data[key][:, k]).max() for key in ("inertial", "coriolis", "gravity", "total")]
         print(f"  {name:<24} " + " ".join(f"{x:14.4g}" for x in vals))
     if args.plot:

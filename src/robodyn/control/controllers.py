@@ -2,21 +2,21 @@
 
 Every controller holds its own model (the plant may be another one: model mismatch) and
 exposes ``lyapunov(t, q, v)`` when the theory gives a Lyapunov function of the closed loop
-with an exact model, and ``desired(t) -> (q_d, qd_d, qdd_d)`` when it tracks a reference.
-Errors are ``e = q_d - q``, ``ed = qd_d - qd`` (except Slotine-Li, written as in its paper
+with an exact model, and ``desired(t) -> (q_d, v_d, a_d)`` when it tracks a reference.
+Errors are ``e = q_d - q``, ``ed = v_d - v`` (except Slotine-Li, written as in its paper
 with ``q~ = q - q_d``). Gains are scalars or (nv,) vectors (diagonal gain matrices), > 0.
 
 =================== ======================================================== ===================================
 controller          law                                                      Lyapunov function
 =================== ======================================================== ===================================
-PDGravity           ``Kp e - Kd qd + g(q)``                                  ``qd^T M qd / 2 + e^T Kp e / 2``
-PIDGravity          ``Kp e + Ki int(e) - Kd qd + g(q)``                      (none reported)
-ComputedTorque      ``M (qdd_d + Kd ed + Kp e) + C qd + g (+ friction)``     ``ed^T ed / 2 + e^T Kp e / 2``
-TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``           ``qd^T M qd / 2 + ex^T Kp ex / 2``
-SlotineLi           ``M qdd_r + C qd_r + g (+ friction) - Kd s``             ``s^T M s / 2 + q~^T Lambda Kd q~``
-AdaptiveSlotineLi   ``Y(q, qd, qd_r, qdd_r) theta_hat - Kd s``,              ``s^T M s / 2 + q~^T Lambda Kd q~``
+PDGravity           ``Kp e - Kd v + g(q)``                                   ``v^T M v / 2 + e^T Kp e / 2``
+PIDGravity          ``Kp e + Ki int(e) - Kd v + g(q)``                       (none reported)
+ComputedTorque      ``M (a_d + Kd ed + Kp e) + C v + g (+ friction)``        ``ed^T ed / 2 + e^T Kp e / 2``
+TaskSpacePD         ``J^T (Kp (x_d - x) - Kd J v) - D v + g(q)``             ``v^T M v / 2 + ex^T Kp ex / 2``
+SlotineLi           ``M a_r + C v_r + g (+ friction) - Kd s``                ``s^T M s / 2 + q~^T Lambda Kd q~``
+AdaptiveSlotineLi   ``Y(q, v, v_r, a_r) theta_hat - Kd s``,                  ``s^T M s / 2 + q~^T Lambda Kd q~``
                     ``theta_hat' = -Gamma^-1 Y^T s``                         ``+ theta~^T Gamma theta~ / 2``
-JointPD             ``tau_ff + Kp e - Kd qd`` on the actuated joints of any  (none reported)
+JointPD             ``tau_ff + Kp e - Kd v`` on the actuated joints of any   (none reported)
                     robot (a floating base unactuated)
 =================== ======================================================== ===================================
 
@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._deprecated import renamed_keywords
 from .. import joints as J
 from ..algorithms.status import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
@@ -113,8 +114,8 @@ class Tracking(Controller):
 
 class PDGravity(Controller):
     """PD control with gravity compensation to a set point ``q_desired``:
-    ``tau = Kp (q_d - q) - Kd qd + g(q)``. With the exact gravity the set point is globally
-    asymptotically stable: ``V = qd^T M qd / 2 + e^T Kp e / 2`` has ``dV/dt = -qd^T Kd qd``
+    ``tau = Kp (q_d - q) - Kd v + g(q)``. With the exact gravity the set point is globally
+    asymptotically stable: ``V = v^T M v / 2 + e^T Kp e / 2`` has ``dV/dt = -v^T Kd v``
     (minus the friction power). Spong et al. (2006), section 8.4."""
 
     def __init__(self, model, q_desired, kp, kd):
@@ -368,7 +369,7 @@ class AdaptiveSlotineLi(SlotineLi):
     with ``Y`` the :func:`robodyn.slotine_li_regressor` of the controller's model (only its
     kinematics is used: joints, placements, gravity) and ``q~``, ``qd_r``, ``qdd_r``, ``s``
     as in :class:`SlotineLi`. ``theta_hat`` (10 per body, order of
-    ``Model.inertial_parameters()``, then the optional ``viscous``, ``coulomb`` and
+    ``Model.inertial_parameters()``, then the optional ``damping``, ``coulomb`` and
     ``armature`` blocks of ``nv`` each, see :func:`robodyn.algorithms.regressor.extended_parameters`)
     starts at ``theta0`` (default: the controller model's own parameters).
 
@@ -393,7 +394,7 @@ class AdaptiveSlotineLi(SlotineLi):
         gamma: ``Gamma``, a scalar, an (np,) diagonal or an (np, np) symmetric
             positive-definite matrix (np parameters): the larger, the slower the adaptation.
         theta0: (np,) initial estimate.
-        viscous, coulomb, armature: also estimate viscous friction (column ``qd_k``), Coulomb
+        damping, coulomb, armature: also estimate viscous friction (column ``v_k``), Coulomb
             friction (``sgn qd_k``, smoothed as in the controller model) and armature
             (``qdd_r,k``) of each joint.
 
@@ -401,10 +402,11 @@ class AdaptiveSlotineLi(SlotineLi):
     section 8.5.2; Siciliano et al. (2009), section 8.5.4.
     """
 
-    def __init__(self, model, reference, lam, kd, gamma, theta0=None, *, theta_true=None, viscous: bool = False,
+    @renamed_keywords(viscous="damping")
+    def __init__(self, model, reference, lam, kd, gamma, theta0=None, *, theta_true=None, damping: bool = False,
                  coulomb: bool = False, armature: bool = False):
         super().__init__(model, reference, lam, kd)
-        self.columns = dict(viscous=bool(viscous), coulomb=bool(coulomb), armature=bool(armature))
+        self.columns = dict(damping=bool(damping), coulomb=bool(coulomb), armature=bool(armature))
         self.state0 = self._parameters("theta0", model if theta0 is None else theta0)
         n = self.state0.shape[0]
         self.gamma = _gain_matrix("gamma", gamma, n)
@@ -454,7 +456,7 @@ class AdaptiveSlotineLi(SlotineLi):
         nb = 10 * self.model.nbodies
         kinetic = kinetic_energy_regressor(self.model, q, s) @ theta[:nb]
         if self.columns["armature"]:
-            arm = theta[nb + self.model.nv * (self.columns["viscous"] + self.columns["coulomb"]):][:self.model.nv]
+            arm = theta[nb + self.model.nv * (self.columns["damping"] + self.columns["coulomb"]):][:self.model.nv]
             kinetic = kinetic + 0.5 * np.sum(arm * s * s, -1)
         d = np.asarray(z, dtype=float) - theta
         return kinetic + np.sum(self.lam * self.kd * e * e, -1) + 0.5 * np.einsum("...i,ij,...j->...", d, self.gamma, d)

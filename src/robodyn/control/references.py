@@ -128,8 +128,9 @@ class Sampled:
 
     @classmethod
     def from_csv(cls, model, path) -> "Sampled":
-        """The ``q`` columns of a trajectory CSV file (format of ``robodyn.io.trajectory_csv``)."""
-        from ..io.trajectory_csv import read_csv
+        """The ``q`` columns of a trajectory or log file (format of :mod:`robodyn.io.log`)."""
+        from ..io.log import read_log
 
-        t, q, _, _ = read_csv(model, path)
+        log = read_log(path, model)
+        t, q = log.t, log.q
         return cls(t, q)

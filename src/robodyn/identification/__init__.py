@@ -4,7 +4,7 @@
     from robodyn import identification as ident
 
     model = rd.models.load("panda")
-    base = ident.base_parameters(model, viscous=True, coulomb=True)       # 43 + 14 columns
+    base = ident.base_parameters(model, damping=True, coulomb=True)       # 43 + 14 columns
     exc = ident.optimize_excitation(model, base, period=10, harmonics=5)   # Fourier series
     exc.trajectory.to_csv("traj.csv", model, duration=20, rate=200)
     log = ident.preprocess(ident.read_log("data.csv", model), cutoff=10)  # filter, differentiate

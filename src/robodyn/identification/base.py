@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._deprecated import renamed_keywords
 from ..algorithms.regressor import EXTRA_COLUMNS, extra_columns, regressor
 from ..joints import NQ
 from ..random import random_configuration
@@ -40,7 +41,7 @@ PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Iz
 def parameter_names(model, **extra) -> list[str]:
     """Names of the regressor columns: ``m1, mx1, ..., Izz1, m2, ...`` (body numbers from 1;
     ``mx = m cx``; inertias about the body origin), then the extra columns of
-    :func:`robodyn.regressor` switched on in ``extra`` (``viscous[joint]``, ...)."""
+    :func:`robodyn.regressor` switched on in ``extra`` (``damping[joint]``, ...)."""
     names = [f"{p}{i + 1}" for i in range(model.nbodies) for p in PARAMETER_NAMES]
     return names + extra_columns(model, **extra)
 
@@ -136,13 +137,14 @@ def _independent_in_order(Ws, candidates, rtol: float) -> list:
     return kept
 
 
-def base_parameters(model, *, viscous: bool = False, coulomb: bool = False, armature: bool = False,
+@renamed_keywords(viscous="damping")
+def base_parameters(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
                     offset: bool = False, n_states: int | None = None, rtol: float = 1e-8,
                     seed: int = 0) -> BaseParameters:
     """Base parameters of ``model`` from the regressor of ``n_states`` random states.
 
     Args:
-        viscous, coulomb, armature, offset: include these extra columns (see
+        damping, coulomb, armature, offset: include these extra columns (see
             :func:`robodyn.regressor`); they are identifiable with the inertial parameters.
         n_states: number of random states (default: enough for 4 rows per column).
         rtol: relative tolerance on the singular values and on the distance of a column to
@@ -153,7 +155,7 @@ def base_parameters(model, *, viscous: bool = False, coulomb: bool = False, arma
         ValueError: when the rank from the singular values and the number of columns kept
             disagree (``rtol`` sits inside a cluster of singular values: no clear gap).
     """
-    extra = dict(viscous=bool(viscous), coulomb=bool(coulomb), armature=bool(armature), offset=bool(offset))
+    extra = dict(damping=bool(damping), coulomb=bool(coulomb), armature=bool(armature), offset=bool(offset))
     columns = tuple(parameter_names(model, **extra))
     p = len(columns)
     if model.nv == 0:

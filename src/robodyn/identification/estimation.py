@@ -52,10 +52,10 @@ class Estimate:
 
 def stack(model, base: BaseParameters, log: Log):
     """``(W, y)``: the base regressor (N nv, r) and the torques (N nv,) of a log whose
-    ``qd``, ``qdd`` and ``tau`` are known (see ``data.preprocess``)."""
-    if log.qd is None or log.qdd is None or log.tau is None:
+    ``v``, ``a`` and ``tau`` are known (see ``data.preprocess``)."""
+    if log.v is None or log.a is None or log.tau is None:
         raise ValueError("the log needs velocities, accelerations and torques; run preprocess() first")
-    W = base.regressor(model, log.q, log.qd, log.qdd)
+    W = base.regressor(model, log.q, log.v, log.a)
     return W.reshape(-1, base.count), log.tau.reshape(-1)
 
 
@@ -179,7 +179,7 @@ def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 
     ``prior`` (p,): standard parameters ``[theta, extra]`` the unobservable directions are
     drawn to (usually the nominal model); ``start``: initial standard parameters (default: the
     least-squares estimate completed towards the prior, each body moved to the nearest
-    consistent one). Friction columns (viscous, Coulomb) and armature are bounded below by 0.
+    consistent one). Friction columns (damping, Coulomb) and armature are bounded below by 0.
     The Jacobian is analytic (block diagonal ``d theta / d x``, :func:`theta_jacobian`);
     ``scipy.optimize.least_squares`` (trust region reflective, for the bounds) evaluates the
     residual at most ``max_nfev`` times.
@@ -208,7 +208,7 @@ def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 
     logs = [10 * i + k for i in range(nb) for k in range(4)]
     lower[logs], upper[logs] = -LOG_BOUND, LOG_BOUND
     nonneg = [10 * nb + k for k, name in enumerate(base.columns[10 * nb:])
-              if name.split("[")[0] in ("viscous", "coulomb", "armature")]
+              if name.split("[")[0] in ("damping", "coulomb", "armature")]
     lower[nonneg] = 0.0
     x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
 

@@ -39,7 +39,7 @@ class FourierTrajectory:
         return int(self.a.shape[1])
 
     def __call__(self, t):
-        """``(q, qd, qdd)``, each (len(t), nv), at times ``t`` (s)."""
+        """``(q, v, a)``, each (len(t), nv), at times ``t`` (s)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
         w = 2.0 * np.pi / self.period
         l = np.arange(1, self.harmonics + 1)
@@ -51,18 +51,19 @@ class FourierTrajectory:
         return q, qd, qdd
 
     def sample(self, duration: float, rate: float):
-        """``(t, q, qd, qdd)`` sampled at ``rate`` Hz over ``[0, duration)``."""
+        """``(t, q, v, a)`` sampled at ``rate`` Hz over ``[0, duration)``."""
         if not (duration > 0 and rate > 0):
             raise ValueError(f"duration and rate must be positive, got {duration}, {rate}")
         t = np.arange(int(round(duration * rate))) / rate
         return (t, *self(t))
 
     def to_csv(self, path, model, duration: float, rate: float) -> Path:
-        """Write ``time, q_<joint>..., qd_<joint>..., qdd_<joint>...`` sampled at ``rate``."""
-        from .data import write_log
+        """Write ``t, q:<joint>..., v:<joint>..., a:<joint>...`` sampled at ``rate`` (robodyn's
+        tabular format, :mod:`robodyn.io.log`)."""
+        from ..io.log import write_log
 
-        t, q, qd, qdd = self.sample(duration, rate)
-        return write_log(path, model, t, q, qd=qd, qdd=qdd)
+        t, q, v, a = self.sample(duration, rate)
+        return write_log(path, model, t, q, v=v, a=a)
 
     def plot(self, path, model, rate: float = 200.0) -> Path:
         """PNG of positions, velocities and accelerations over one period."""
@@ -73,7 +74,7 @@ class FourierTrajectory:
 
         t, q, qd, qdd = self.sample(self.period, rate)
         fig, axes = plt.subplots(3, 1, figsize=(9, 8), sharex=True)
-        for ax, x, label in zip(axes, (q, qd, qdd), ("q [rad or m]", "qd [/s]", "qdd [/s^2]")):
+        for ax, x, label in zip(axes, (q, qd, qdd), ("q [rad or m]", "v [/s]", "a [/s^2]")):
             for j in range(x.shape[1]):
                 ax.plot(t, x[:, j], label=model.joint_names[j])
             ax.set_ylabel(label)

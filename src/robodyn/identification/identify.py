@@ -1,6 +1,6 @@
 """The identification pipeline: base parameters, estimation, prediction, identified model.
 
-    base = base_parameters(model, viscous=True, coulomb=True)
+    base = base_parameters(model, damping=True, coulomb=True)
     result = identify(model, preprocess(read_log("data.csv", model), cutoff=10), method="wls")
     result.predict(other_log)          # torques of another motion
     result.identified_model()          # a Model with the estimated parameters
@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._deprecated import renamed_keywords
 from ..algorithms.regressor import extended_parameters
 from ..errors import ModelError, RobodynWarning
 from ._blas import one_blas_thread
@@ -38,9 +39,9 @@ class Identification:
 
     def predict(self, log: Log) -> np.ndarray:
         """Joint torques (N, nv) of the identified model along a log's motion."""
-        if log.qd is None or log.qdd is None:
+        if log.v is None or log.a is None:
             raise ValueError("predict: the log needs velocities and accelerations; run preprocess() first")
-        return self.base.regressor(self.model, log.q, log.qd, log.qdd) @ self.estimate.beta
+        return self.base.regressor(self.model, log.q, log.v, log.a) @ self.estimate.beta
 
     def standard_parameters(self) -> np.ndarray:
         """Full parameters ``[theta, extra]``: the physically consistent estimate, or for
@@ -54,10 +55,10 @@ class Identification:
         return nominal_parameters(self.model, self.base)
 
     def extra(self) -> dict:
-        """Identified per-dof extra parameters by kind (``viscous``, ``coulomb``, ...)."""
+        """Identified per-dof extra parameters by kind (``damping``, ``coulomb``, ...)."""
         theta = self.standard_parameters()
         out, col, nv = {}, 10 * self.model.nbodies, self.model.nv
-        for kind in ("viscous", "coulomb", "armature", "offset"):
+        for kind in ("damping", "coulomb", "armature", "offset"):
             if self.base.extra[kind]:
                 out[kind] = theta[col:col + nv]
                 col += nv
@@ -73,14 +74,13 @@ class Identification:
         """
         theta = self.standard_parameters()
         nb = self.model.nbodies
-        changes = {"inertia": theta[:10 * nb].reshape(nb, 10)}
-        fields = {"viscous": "damping", "coulomb": "coulomb", "armature": "armature"}
+        changes = {"theta": theta[:10 * nb].reshape(nb, 10)}
         for kind, values in self.extra().items():
-            if kind in fields:
+            if kind in ("damping", "coulomb", "armature"):  # model fields of the same names
                 if np.any(values < 0):
                     warnings.warn(f"identified {kind} friction/armature negative at dofs "
                                   f"{np.flatnonzero(values < 0).tolist()}: set to 0", RobodynWarning, stacklevel=2)
-                changes[fields[kind]] = np.maximum(values, 0.0)
+                changes[kind] = np.maximum(values, 0.0)
         try:
             return self.model.replace(**changes, physical="error")
         except ModelError as e:
@@ -107,20 +107,21 @@ class Identification:
 def nominal_parameters(model, base: BaseParameters) -> np.ndarray:
     """The model's own ``[theta, extra]`` in the column order of ``base`` (offsets 0)."""
     e = base.extra
-    return extended_parameters(model, viscous=e["viscous"], coulomb=e["coulomb"], armature=e["armature"],
+    return extended_parameters(model, damping=e["damping"], coulomb=e["coulomb"], armature=e["armature"],
                                offset=np.zeros(model.nv) if e["offset"] else None)
 
 
-def identify(model, log: Log, *, method: str = "ols", viscous: bool = True, coulomb: bool = True,
+@renamed_keywords(viscous="damping")
+def identify(model, log: Log, *, method: str = "ols", damping: bool = True, coulomb: bool = True,
              armature: bool = False, offset: bool = False, base: BaseParameters | None = None,
              prior_weight: float = 1e-8) -> Identification:
     """Identify the base parameters of ``model`` from a preprocessed log.
 
     Args:
-        log: samples with ``q``, ``qd``, ``qdd`` and ``tau`` (``data.preprocess`` fills the
+        log: samples with ``q``, ``v``, ``a`` and ``tau`` (``data.preprocess`` fills the
             derivatives).
         method: ``"ols"``, ``"wls"`` or ``"physical"`` (see :mod:`.estimation`).
-        viscous, coulomb, armature, offset: the extra columns identified with the inertial
+        damping, coulomb, armature, offset: the extra columns identified with the inertial
             parameters (ignored when ``base`` is given: its own switches apply).
         base: precomputed base parameters (default :func:`base_parameters` of the model).
         prior_weight: weight of the nominal parameters in ``physical``.
@@ -128,7 +129,7 @@ def identify(model, log: Log, *, method: str = "ols", viscous: bool = True, coul
     if method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     if base is None:
-        base = base_parameters(model, viscous=viscous, coulomb=coulomb, armature=armature, offset=offset)
+        base = base_parameters(model, damping=damping, coulomb=coulomb, armature=armature, offset=offset)
     W, y = stack(model, base, log)
     with one_blas_thread():
         s = np.linalg.svd(W, compute_uv=False)

@@ -86,7 +86,7 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     _save(fig, paths[-1])
     plt.close(fig)
 
-    W = result.base.regressor(model, log.q, log.qd, log.qdd).reshape(-1, result.base.count)
+    W = result.base.regressor(model, log.q, log.v, log.a).reshape(-1, result.base.count)
     s = np.linalg.svd(W, compute_uv=False)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.semilogy(np.arange(1, s.size + 1), s, "o-")

@@ -156,7 +156,7 @@ def to_pinocchio(model: Model):
         placement = pin.SE3(np.asarray(model.X_tree_R[i]), np.asarray(model.X_tree_p[i]))
         jid = pm.addJoint(parent + 1, _pin_joint(pin, int(model.joint_type[i]), model.joint_axis[i], model.joint_pitch[i]),
                           placement, model.body_joint_names[i])
-        pm.appendBodyToJoint(jid, _pin_inertia(pin, model.inertia[i]), pin.SE3.Identity())
+        pm.appendBodyToJoint(jid, _pin_inertia(pin, model.theta[i]), pin.SE3.Identity())
         joint_frame = pm.addJointFrame(jid, body_frame[parent])
         body_frame[i] = pm.addBodyFrame(model.link_names[i], jid, pin.SE3.Identity(), joint_frame)
     for name, b, R, p in zip(model.frame_names, model.frame_body, model.frame_R, model.frame_p):
@@ -297,7 +297,7 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
         joint_pitch=np.asarray(pitch, dtype=float),
         X_tree_R=np.reshape([pm.jointPlacements[j].rotation for j in joints], (-1, 3, 3)),
         X_tree_p=np.reshape([pm.jointPlacements[j].translation for j in joints], (-1, 3)),
-        inertia=theta, link_names=names, body_joint_names=[pm.names[j] for j in joints],
+        theta=theta, link_names=names, body_joint_names=[pm.names[j] for j in joints],
         gravity=gravity.linear, lower=lower, upper=upper, damping=pm.damping, armature=pm.armature,
         frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
         frame_R=np.reshape([f[2] for f in frames], (-1, 3, 3)), frame_p=np.reshape([f[3] for f in frames], (-1, 3)),

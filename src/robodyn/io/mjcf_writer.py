@@ -65,12 +65,12 @@ class _Writer:
         self.lines: list[str] = []
         # MuJoCo refuses principal moments below 1e-15 (point masses): they are raised to
         # 1e-12 of the largest inertia of the model by <compiler boundinertia>, with a warning
-        scale = max([np.abs(mass_com_inertia(t)[2]).max() for t in model.inertia] + [0.0])
+        scale = max([np.abs(mass_com_inertia(t)[2]).max() for t in model.theta] + [0.0])
         self.bound = 1e-12 * scale if scale > 0 else 1e-12
         self.bounded: list[str] = []
 
     def massless(self, i) -> bool:
-        m, _, Ic = mass_com_inertia(self.m.inertia[i])
+        m, _, Ic = mass_com_inertia(self.m.theta[i])
         return m <= 0.0 and not np.any(Ic)
 
     def chain(self, i) -> list[int]:
@@ -134,7 +134,7 @@ class _Writer:
             self.lines.append(f"{indent}<body name={quoteattr(m.link_names[last])} {_pose(R0, p0)}>")
             for b, (R, p) in zip(chain, C):
                 self.joint(b, R.T @ m.joint_axis[b], -R.T @ p, indent + "  ")
-        mass, c, Ic = mass_com_inertia(m.inertia[last])
+        mass, c, Ic = mass_com_inertia(m.theta[last])
         if mass <= 0:
             raise ValueError(f"write_mjcf: body {m.link_names[last]!r} moves without mass, which MuJoCo refuses "
                              "(only a chain of massless bodies with one child each merges into one MuJoCo body)")

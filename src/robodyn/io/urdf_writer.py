@@ -66,7 +66,7 @@ def _inertial(theta) -> list[str]:
 
 def _link_and_joint(model, i: int, kind: str, parent: str) -> list[str]:
     """Body ``i``'s link, and its joint's opening up to the origin (the caller closes it)."""
-    return [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.inertia[i]), "  </link>",
+    return [f"  <link name={quoteattr(model.link_names[i])}>", *_inertial(model.theta[i]), "  </link>",
             f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"{kind}\">",
             f"    <parent link={quoteattr(parent)}/>", f"    <child link={quoteattr(model.link_names[i])}/>",
             f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}"]
@@ -96,7 +96,7 @@ def write_urdf(model, path=None) -> str:
         return root if body < 0 else model.link_names[body]
 
     lines.append(f"  <link name={quoteattr(root)}>")
-    lines += _inertial(model.inertia[0]) if floating else []
+    lines += _inertial(model.theta[0]) if floating else []
     lines.append("  </link>")
     joint_names = set(model.body_joint_names)
     for i in range(model.nbodies):

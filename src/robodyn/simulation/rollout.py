@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._deprecated import renamed_keyword
 from ..algorithms.driver import batch_kernel, chunks
 from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
@@ -64,24 +65,24 @@ def _states(name, x, n):
     return a.reshape(-1, n)
 
 
-def _bodies(model, inertia, B: int) -> np.ndarray:
+def _bodies(model, theta, B: int) -> np.ndarray:
     """The body table of each rollout (B or 1, nb, BODY_COLUMNS) with its inertial parameters."""
     from ..layout import INERTIA, INERTIA_END
     from ..model import consistent_inertial_parameters
 
     body = model.kernel.body
-    if inertia is None:
+    if theta is None:
         return body[None]
     try:
-        theta = np.array(inertia, dtype=float)
+        theta = np.array(theta, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"inertia: expected an array of numbers, got {type(inertia).__name__}") from None
+        raise ValueError(f"theta: expected an array of numbers, got {type(theta).__name__}") from None
     if theta.ndim != 3 or theta.shape[0] not in (1, B) or theta.shape[1:] != (model.nbodies, 10):
-        raise ValueError(f"inertia: expected shape ({B}, {model.nbodies}, 10), got {theta.shape}")
+        raise ValueError(f"theta: expected shape ({B}, {model.nbodies}, 10), got {theta.shape}")
     good = consistent_inertial_parameters(theta.reshape(-1, 10)).reshape(theta.shape[:2])
     if not good.all():
         b, i = (int(x) for x in np.argwhere(~good)[0])
-        raise ValueError(f"inertia: rollout {b}, body {i} ({model.link_names[i]!r}): {theta[b, i].tolist()} are not "
+        raise ValueError(f"theta: rollout {b}, body {i} ({model.link_names[i]!r}): {theta[b, i].tolist()} are not "
                          f"the inertial parameters of a rigid body (mass >= 0, inertia about the centre of mass "
                          f"positive semi-definite with the triangle inequality)")
     bodies = np.repeat(body[None], theta.shape[0], axis=0)
@@ -90,21 +91,23 @@ def _bodies(model, inertia, B: int) -> np.ndarray:
 
 
 def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, contacts=None, every: int = 1,
-            inertia=None) -> Rollouts:
+            theta=None, inertia=None) -> Rollouts:
     """``B`` simulations of ``duration`` seconds with steps of ``dt`` from the initial states
     ``q0`` (B, nq) and ``v0`` (B, nv) (one of them may be a single state), in parallel (see
     the module docstring), keeping every ``every``-th sample (times ``k every dt``; the steps'
     accelerations, torques and contact forces at those samples), so that long batches fit in
-    memory. ``inertia``: None, or (B, nbodies, 10) the inertial parameters of each rollout's
-    robot (``Model.inertia``'s layout; checked as a model's are): Monte Carlo over masses and
+    memory. ``theta``: None, or (B, nbodies, 10) the inertial parameters of each rollout's
+    robot (``Model.theta``'s layout; checked as a model's are): Monte Carlo over masses and
     inertias, the controller keeping its own model. Raises for the first rollout that fails
     (naming it and the time); warns, as :func:`robodyn.simulate`, when contact solves stopped
     above ``warn_above``."""
+    if inertia is not None:  # the old spelling of ``theta``
+        theta = renamed_keyword("inertia", inertia, "theta", theta, "rollout()", default=None)
     q0, v0 = _states("q0", q0, model.nq), _states("v0", v0, model.nv)
-    B = max(q0.shape[0], v0.shape[0], np.shape(inertia)[0] if np.ndim(inertia) == 3 else 1)
+    B = max(q0.shape[0], v0.shape[0], np.shape(theta)[0] if np.ndim(theta) == 3 else 1)
     if q0.shape[0] not in (1, B) or v0.shape[0] not in (1, B):
         raise ValueError(f"q0, v0: {q0.shape[0]} and {v0.shape[0]} states do not broadcast")
-    bodies = _bodies(model, inertia, B)
+    bodies = _bodies(model, theta, B)
     duration, dt = positive_number("duration", duration), positive_number("dt", dt)
     if dt > duration:
         raise ValueError(f"dt: must not exceed duration ({duration}), got {dt}")

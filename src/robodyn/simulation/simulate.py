@@ -19,6 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .._deprecated import renamed_keyword
 from .. import joints as J
 from ..algorithms.rnea import external_wrenches, rnea
 from ..algorithms.status import OK, raise_for_status
@@ -202,8 +203,9 @@ def raise_at(model, status, t, q, v, tau):
 
 
 def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str | None = None, *,
-             contacts=None, f_ext=None, f_ext_frame: str = "local", constraints=None, baumgarte=None,
-             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None) -> Trajectory:
+             contacts=None, f_ext=None, frame: str = "local", constraints=None, baumgarte=None,
+             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None,
+             f_ext_frame=None) -> Trajectory:
     """Simulate the robot from ``(q0, v0)`` for ``duration`` seconds, sampled every ``dt``.
 
     Args:
@@ -229,7 +231,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             force and distance and the solver's sweeps and residual at every sample; a step
             whose solve did not reach the tolerance is reported in one warning.
         f_ext: external wrenches ``[force, torque]`` on the bodies, (nbodies, 6) in
-            ``f_ext_frame`` (``"local"``, ``"world"``, ``"local_world_aligned"``, as
+            ``frame`` (``"local"``, ``"world"``, ``"local_world_aligned"``, as
             :func:`robodyn.rnea`): an array (constant, compiled runs stay compiled) or a callable
             ``(t, q, v) -> (nbodies, 6)`` evaluated at every stage (a push, a spring to the
             world, an interaction force).
@@ -253,6 +255,8 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Reference: Hairer, Lubich, Wanner, *Geometric Numerical Integration* (2006), IV.8
     (Runge-Kutta methods in local charts of a manifold).
     """
+    if f_ext_frame is not None:  # the old spelling of ``frame``
+        frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "simulate()")
     q0 = _vector("q0", q0, model.nq)
     v0 = _vector("v0", v0, model.nv)
     duration, dt = positive_number("duration", duration), positive_number("dt", dt)
@@ -291,7 +295,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if constraints and contacts is not None:
         raise ValueError("constraints: not with contacts (bilateral constraints and contacts in one solve are not "
                          "supported yet); model the contacts or the constraints alone")
-    plant, law = _Plant(model, f_ext, f_ext_frame, constraints, baumgarte), _Law(controller, model)
+    plant, law = _Plant(model, f_ext, frame, constraints, baumgarte), _Law(controller, model)
     if constraints:
         from ..algorithms.constrained import constrained_dynamics
 

@@ -1,16 +1,16 @@
-"""The result of a simulation, :class:`Trajectory`; its CSV format is that of
-:mod:`robodyn.io.trajectory_csv`.
+"""The result of a simulation, :class:`Trajectory`; written and read in robodyn's one
+tabular format (:mod:`robodyn.io.log`).
 """
 
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..files import atomic_path
-from ..io.trajectory_csv import coordinate_names
+from ..io.log import read_log, write_log
+
+CONTACT_COLUMNS = (("force", ("fx", "fy", "fz")), ("normal", ("nx", "ny", "nz")), ("distance", ("distance",)))
 
 
 @dataclass(frozen=True)
@@ -79,14 +79,65 @@ class Trajectory:
         return None if self.q_desired is None else self.q - self.q_desired
 
     def to_csv(self, path) -> None:
-        """Write the samples in the CSV format of the module docstring."""
-        qn, vn = coordinate_names(self.model)
-        header = (["t"] + [f"q:{n}" for n in qn] + [f"v:{n}" for n in vn] + [f"a:{n}" for n in vn]
-                  + [f"tau:{n}" for n in vn] + ["energy"] + (["lyapunov"] if self.lyapunov is not None else []))
-        cols = [self.t[:, None], self.q, self.v, self.a, self.tau, self.energy[:, None]]
+        """Write the samples in robodyn's tabular format (:mod:`robodyn.io.log`; Parquet for a
+        ``.parquet`` path): ``t, q:, v:, a:, tau:`` then ``kinetic, potential, energy``, and
+        what the run has: ``lyapunov``; ``q_desired:<coordinate>``, ``v_desired:<dof>``;
+        ``controller_state:<k>``; per contact pair ``contact:<pair>:fx, :fy, :fz`` (its
+        force), ``:nx, :ny, :nz`` (the normal), ``:distance`` and ``:mu``, with
+        ``solver_iterations, solver_residual``; ``constraint_force:<k>``.
+        :meth:`from_csv` reads it all back."""
+        extra = {"kinetic": self.kinetic, "potential": self.potential, "energy": self.energy}
         if self.lyapunov is not None:
-            cols.append(self.lyapunov[:, None])
-        with atomic_path(path) as tmp, open(tmp, "w", newline="") as f:
-            w = csv.writer(f)
-            w.writerow(header)
-            w.writerows(np.hstack(cols).tolist())
+            extra["lyapunov"] = self.lyapunov
+        for name, x, names in (("q_desired", self.q_desired, self.model.q_names),
+                               ("v_desired", self.v_desired, self.model.dof_names)):
+            if x is not None:
+                extra.update({f"{name}:{n}": x[:, k] for k, n in enumerate(names)})
+        for name, x in (("controller_state", self.controller_state), ("constraint_force", self.constraint_force)):
+            if x is not None:
+                extra.update({f"{name}:{k}": x[:, k] for k in range(x.shape[1])})
+        if self.contact_names is not None:
+            for p, pair in enumerate(self.contact_names):
+                for field_, parts in CONTACT_COLUMNS:
+                    x = getattr(self, f"contact_{field_}")[:, p]
+                    extra.update({f"contact:{pair}:{c}": x if x.ndim == 1 else x[:, k] for k, c in enumerate(parts)})
+                extra[f"contact:{pair}:mu"] = np.full(self.t.shape, self.contact_friction[p])
+            extra.update(solver_iterations=self.solver_iterations, solver_residual=self.solver_residual)
+        write_log(path, self.model, self.t, self.q, v=self.v, a=self.a, tau=self.tau, extra=extra)
+
+    @classmethod
+    def from_csv(cls, path, model) -> "Trajectory":
+        """The trajectory written by :meth:`to_csv` (or any file of robodyn's tabular format
+        with ``t``, ``q``, ``v``, ``a`` and ``tau`` columns: the energies are then computed)."""
+        log = read_log(path, model)
+        missing = [k for k in ("v", "a", "tau") if getattr(log, k) is None]
+        if missing:
+            raise ValueError(f"{path}: a trajectory needs the {', '.join(missing)} columns as well as t and q")
+        x = dict(log.extra)
+
+        def block(prefix, names):
+            cols = [f"{prefix}:{n}" for n in names]
+            return np.column_stack([x.pop(c) for c in cols]) if cols and all(c in x for c in cols) else None
+
+        def numbered(prefix):
+            count = sum(1 for k in x if k.startswith(prefix + ":") and k[len(prefix) + 1:].isdigit())
+            return block(prefix, [str(k) for k in range(count)])
+
+        if not all(k in x for k in ("kinetic", "potential")):
+            from ..algorithms.energy import kinetic_energy, potential_energy
+            x["kinetic"] = kinetic_energy(model, log.q, log.v) + 0.5 * (log.v * log.v) @ model.armature
+            x["potential"] = potential_energy(model, log.q)
+        kinetic, potential = x.pop("kinetic"), x.pop("potential")
+        x.pop("energy", None)
+        fields = dict(lyapunov=x.pop("lyapunov", None), q_desired=block("q_desired", model.q_names),
+                      v_desired=block("v_desired", model.dof_names), controller_state=numbered("controller_state"),
+                      constraint_force=numbered("constraint_force"))
+        pairs = list(dict.fromkeys(k[len("contact:"):].rsplit(":", 1)[0] for k in x if k.startswith("contact:")))
+        if pairs:
+            contact = {f: np.stack([block(f"contact:{p}", parts) for p in pairs], axis=1) for f, parts in CONTACT_COLUMNS}
+            fields.update(contact_names=tuple(pairs), contact_force=contact["force"], contact_normal=contact["normal"],
+                          contact_distance=contact["distance"][..., 0],
+                          contact_friction=np.array([x.pop(f"contact:{p}:mu")[0] for p in pairs]),
+                          solver_iterations=x.pop("solver_iterations", None), solver_residual=x.pop("solver_residual", None))
+        return cls(model=model, t=log.t, q=log.q, v=log.v, a=log.a, tau=log.tau, kinetic=kinetic, potential=potential,
+                   energy=kinetic + potential, **fields)

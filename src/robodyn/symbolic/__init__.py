@@ -2,7 +2,7 @@
 
     import robodyn as rd
     eom = rd.symbolic.equations_of_motion(rd.models.load("planar_2r"))
-    eom.M, eom.C, eom.g, eom.T, eom.U, eom.L, eom.tau     # sympy, in q, qd, qdd
+    eom.M, eom.C, eom.g, eom.T, eom.U, eom.L, eom.tau     # sympy, in q, v, a
     M = eom.to_function("M")                              # NumPy, batched: M(q) (..., n, n)
     M = rd.symbolic.recursive_dynamics(model).to_numba("M")   # fast M without deriving
     eom.to_c("out/")                                      # C source and header
@@ -10,9 +10,9 @@
 
 Symbolic models (:class:`SymbolicModel`) come from a numeric model (:func:`from_model`), a
 DH table with symbols (:func:`from_dh`), or either with named inertial parameters
-(:func:`with_inertia_symbols`); :func:`recursive_dynamics` generates ``M``, ``C qd``, ``g``
+(:func:`with_inertia_symbols`); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``
 and ``tau`` from the recursions without the expanded derivation; :func:`regressor` gives
-``Y(q, qd, qdd)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
+``Y(q, v, a)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
 """
 
 from .equations import EquationsOfMotion, equations_of_motion

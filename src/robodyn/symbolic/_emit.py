@@ -35,8 +35,8 @@ class Emitter(VectorAlgebra):
         self.pos = [trig_names(k)[0] if r else model.q[k] for k, r in enumerate(self.revolute)]
         self.cos = [trig_names(k)[1] if r else None for k, r in enumerate(self.revolute)]
         self.zero, self.one = sp.S.Zero, sp.S.One
-        self.qd = list(model.qd) if rates else [self.zero] * n
-        self.qdd = list(model.qdd) if accelerations else [self.zero] * n
+        self.qd = list(model.v) if rates else [self.zero] * n
+        self.qdd = list(model.a) if accelerations else [self.zero] * n
         self.assignments = []
         self._names = {}
         self._symbols = sp.numbered_symbols("x", real=True)

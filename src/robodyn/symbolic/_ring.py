@@ -82,13 +82,13 @@ class TrigRing(VectorAlgebra):
         cos = [sp.Dummy(f"c{k + 1}") for k, r in enumerate(self.revolute) if r]
         exprs = list(model.gravity) + [*model.armature]
         for i in range(model.nbodies):
-            exprs += [*model.axis[i], *model.R_tree[i], *model.p_tree[i], *model.inertia[i]]
+            exprs += [*model.joint_axis[i], *model.X_tree_R[i], *model.X_tree_p[i], *model.theta[i]]
         atoms = set()
         for e in exprs:
             atoms |= _nonpolynomial_atoms(e)
         self.atom_dummies = {a: sp.Dummy(f"a{j}") for j, a in enumerate(sorted(atoms, key=sp.default_sort_key))}
         params = sorted(set().union(*(e.free_symbols for e in exprs)) - set(model.q), key=lambda s: s.name)
-        gens = pos + cos + list(model.qd) + list(model.qdd) + params + list(self.atom_dummies.values())
+        gens = pos + cos + list(model.v) + list(model.a) + params + list(self.atom_dummies.values())
         self.ring = PolyRing(gens, QQ, "lex")
         g = self.ring.gens
         self.pos = g[:n]

@@ -14,11 +14,11 @@ from ._ring import TrigRing
 def joint_placement(rg: TrigRing, i: int):
     """``(R, p)`` of body ``i`` in its parent: ``X_tree * X_J(q_i)``.
 
-    Revolute about the unit axis ``a``: ``R = R_tree (a a^T + c (1 - a a^T) + s [a]x)``
-    (Rodrigues), ``p = p_tree``; prismatic: ``R = R_tree``, ``p = p_tree + R_tree a x``.
+    Revolute about the unit axis ``a``: ``R = X_tree_R (a a^T + c (1 - a a^T) + s [a]x)``
+    (Rodrigues), ``p = X_tree_p``; prismatic: ``R = X_tree_R``, ``p = X_tree_p + X_tree_R a x``.
     """
     m = rg.model
-    Rt, pt, a = rg.mat(m.R_tree[i]), rg.vec(m.p_tree[i]), rg.vec(m.axis[i])
+    Rt, pt, a = rg.mat(m.X_tree_R[i]), rg.vec(m.X_tree_p[i]), rg.vec(m.joint_axis[i])
     if not rg.revolute[i]:
         d = rg.matvec(Rt, a)
         return Rt, [pt[r] + d[r] * rg.pos[i] for r in range(3)]
@@ -30,7 +30,7 @@ def joint_placement(rg: TrigRing, i: int):
 
 def motion_subspace(rg: TrigRing, i: int) -> list:
     """``S_i`` (6,) in body ``i``'s frame."""
-    a = rg.vec(rg.model.axis[i])
+    a = rg.vec(rg.model.joint_axis[i])
     z = [rg.zero] * 3
     return z + a if rg.revolute[i] else a + z
 
@@ -112,7 +112,7 @@ def potential_energy(rg: TrigRing, poses) -> "PolyElement":  # noqa: F821
     g = rg.vec(rg.model.gravity)
     U = rg.zero
     for i, (oR, op) in enumerate(poses):
-        th = [rg.const(t) for t in rg.model.inertia[i]]
+        th = [rg.const(t) for t in rg.model.theta[i]]
         Rh = rg.matvec(oR, th[1:4])
         U = U - sum((g[r] * (th[0] * op[r] + Rh[r]) for r in range(3)), rg.zero)
     return rg.reduce(U)

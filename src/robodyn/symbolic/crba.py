@@ -25,7 +25,7 @@ def mass_matrix(rg) -> list:
     m = rg.model
     X = [joint_placement(rg, i) for i in range(m.nbodies)]
     S = [motion_subspace(rg, i) for i in range(m.nbodies)]
-    Ic = [rg.vec(th) for th in m.inertia]
+    Ic = [rg.vec(th) for th in m.theta]
     M = [[rg.zero] * m.nv for _ in range(m.nv)]
     for i in reversed(range(m.nbodies)):
         F = inertia_mul(rg, Ic[i], S[i])

@@ -1,24 +1,25 @@
-"""Closed-form equations of motion ``M(q) qdd + C(q, qd) qd + g(q) = tau``.
+"""Closed-form equations of motion ``M(q) a + C(q, v) v + g(q) = tau``.
 
 :func:`equations_of_motion` derives them by the energy route (:mod:`.lagrange`) or the
 recursive Newton-Euler route (:mod:`.newton_euler`) in exact trigonometric polynomials
 (:mod:`._ring`), and returns :class:`EquationsOfMotion` with the terms as sympy expressions
-in ``q = (q1, ...)``, ``qd = (qd1, ...)``, ``qdd = (qdd1, ...)``:
+in ``q = (q1, ...)``, ``v = (qd1, ...)``, ``a = (qdd1, ...)`` (the joint velocities and
+accelerations, named as everywhere in robodyn; their symbols print as q-dot, q-double-dot):
 
     M    (n, n)  mass matrix, with the joints' armature on the diagonal
-    C    (n, n)  Christoffel matrix C_ij = sum_k Gamma_ijk qd_k,
+    C    (n, n)  Christoffel matrix C_ij = sum_k Gamma_ijk v_k,
                  Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2, so Mdot - 2C is
                  skew-symmetric (as robodyn.coriolis_matrix)
-    C_qd (n,)    C qd, the Coriolis and centrifugal forces
+    C_v  (n,)    C v, the Coriolis and centrifugal forces
     g    (n,)    gravity forces dU/dq (as robodyn.gravity)
-    T, U, L      kinetic energy qd^T M qd / 2, potential energy -sum m_i g . p_ci, T - U
-    tau  (n,)    M qdd + C qd + g (as robodyn.rnea without friction)
+    T, U, L      kinetic energy v^T M v / 2, potential energy -sum m_i g . p_ci, T - U
+    tau  (n,)    M a + C v + g (as robodyn.rnea without friction)
 
 Friction is not part of these terms. Expressions of up to ``TRIG_TERMS`` terms are rewritten
 with the angle-sum rules (sympy's ``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay
 otherwise in the canonical expanded form (no ``simplify`` or ``trigsimp`` on big
 expressions, which is what makes other tools take hours). Code generation
-(:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) writes ``M``, ``C_qd``,
+(:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) writes ``M``, ``C_v``,
 ``g`` and ``tau`` by default as the straight-line code of the recursions (:mod:`.recursive`:
 not expanded, fast to compile and to run) and the other terms, or every term with
 ``form="expanded"``, as the expanded expressions after common-subexpression elimination.
@@ -31,6 +32,7 @@ from functools import cached_property
 import sympy as sp
 from sympy.simplify.fu import TR10i
 
+from .._deprecated import renamed_attribute
 from . import codegen, lagrange, newton_euler
 from ._ring import TrigRing, readable_numbers
 from ._terms import GeneratedCode, check_form, check_term, signature
@@ -84,7 +86,7 @@ class EquationsOfMotion(GeneratedCode):
         self._rg = rg
         n = model.nv
         self.n = n
-        self.q, self.qd, self.qdd = model.q, model.qd, model.qdd
+        self.q, self.v, self.a = model.q, model.v, model.a
         self.parameters = model.parameters()
         self._programs = {}
         tau = result["tau"]
@@ -93,13 +95,13 @@ class EquationsOfMotion(GeneratedCode):
             "tau": tau,
             "M": [[rg.coefficient(tau[i], j) for j in range(n)] for i in range(n)],
             "g": [p.get((0, 0), rg.zero) for p in parts],
-            "C_qd": [p.get((2, 0), rg.zero) for p in parts],
+            "C_v": [p.get((2, 0), rg.zero) for p in parts],
             "T": result["T"],
             "U": result["U"],
         }
         self._poly["L"] = result["T"] - result["U"]
         if method == "newton_euler":
-            self._poly["C"] = christoffel_from_quadratic(rg, self._poly["C_qd"], n)
+            self._poly["C"] = christoffel_from_quadratic(rg, self._poly["C_v"], n)
         else:
             self._poly["C"] = christoffel_matrix(rg, self._poly["M"])
         extra = set(parts[0]) if n else set()
@@ -122,7 +124,7 @@ class EquationsOfMotion(GeneratedCode):
         p = self._poly[name]
         if name in ("M", "C"):
             return sp.Matrix(self.n, self.n, [self._expr(x, trig) for row in p for x in row])
-        if name in ("g", "C_qd", "tau"):
+        if name in ("g", "C_v", "tau"):
             return sp.Matrix(self.n, 1, [self._expr(x, trig) for x in p])
         return self._expr(p, trig)
 
@@ -133,13 +135,17 @@ class EquationsOfMotion(GeneratedCode):
 
     @cached_property
     def C(self) -> sp.Matrix:
-        """Christoffel matrix ``C(q, qd)`` (n x n), ``Mdot - 2C`` skew-symmetric."""
+        """Christoffel matrix ``C(q, v)`` (n x n), ``Mdot - 2C`` skew-symmetric."""
         return self._shaped("C")
 
     @cached_property
-    def C_qd(self) -> sp.Matrix:
-        """Coriolis and centrifugal forces ``C(q, qd) qd`` (n x 1)."""
-        return self._shaped("C_qd")
+    def C_v(self) -> sp.Matrix:
+        """Coriolis and centrifugal forces ``C(q, v) v`` (n x 1)."""
+        return self._shaped("C_v")
+
+    qd = renamed_attribute("qd", "v")
+    qdd = renamed_attribute("qdd", "a")
+    C_qd = renamed_attribute("C_qd", "C_v")
 
     @cached_property
     def g(self) -> sp.Matrix:
@@ -148,12 +154,12 @@ class EquationsOfMotion(GeneratedCode):
 
     @cached_property
     def tau(self) -> sp.Matrix:
-        """Joint forces ``M qdd + C qd + g`` (n x 1)."""
+        """Joint forces ``M a + C v + g`` (n x 1)."""
         return self._shaped("tau")
 
     @cached_property
     def T(self) -> sp.Expr:
-        """Kinetic energy ``qd^T M qd / 2``."""
+        """Kinetic energy ``v^T M v / 2``."""
         return self._shaped("T")
 
     @cached_property
@@ -178,8 +184,8 @@ class EquationsOfMotion(GeneratedCode):
         return self._poly
 
     def term(self, name: str):
-        """A term by name: ``"M"``, ``"C"``, ``"C_qd"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""
-        check_term(name)
+        """A term by name: ``"M"``, ``"C"``, ``"C_v"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""
+        name = check_term(name)
         return getattr(self, name)
 
     def equals(self, other: "EquationsOfMotion", name: str) -> bool:
@@ -195,12 +201,12 @@ class EquationsOfMotion(GeneratedCode):
 
         ``form="expanded"``: the expanded term (as :attr:`M`, :attr:`C`, ...) after
         common-subexpression elimination; ``form="recursive"``: ``M`` by the
-        composite-rigid-body recursion, ``C_qd``, ``g``, ``tau`` by the Newton-Euler recursion
+        composite-rigid-body recursion, ``C_v``, ``g``, ``tau`` by the Newton-Euler recursion
         (:mod:`.recursive`: straight-line code, not expanded, much faster for 6 and more
         joints); ``form="auto"`` (default): recursive for these four terms, expanded for
         ``C``, ``T``, ``U``, ``L``. Both forms compute the same functions."""
         check_form(form)
-        check_term(name)
+        name = check_term(name)
         if form == "auto":
             form = "recursive" if name in RECURSIONS else "expanded"
         if form == "recursive" and name not in RECURSIONS:

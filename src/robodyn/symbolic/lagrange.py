@@ -31,7 +31,7 @@ def mass_matrix(rg: TrigRing) -> list:
         cols = {} if par < 0 else {k: motion_act_inv(rg, R, p, col) for k, col in J[par].items()}
         cols[i] = motion_subspace(rg, i)
         J.append(cols)
-        theta = rg.vec(m.inertia[i])
+        theta = rg.vec(m.theta[i])
         for a, Ja in cols.items():
             f = inertia_mul(rg, theta, Ja)
             for b, Jb in cols.items():

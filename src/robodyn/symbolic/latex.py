@@ -14,22 +14,22 @@ from ._ring import readable_numbers
 _DESCRIPTION = {
     "M": "Mass matrix $M(q)$",
     "C": r"Christoffel matrix $C(q, \dot q)$ ($\dot M - 2C$ is skew-symmetric)",
-    "C_qd": r"Coriolis and centrifugal forces $C(q, \dot q)\,\dot q$",
+    "C_v": r"Coriolis and centrifugal forces $C(q, \dot q)\,\dot q$",
     "g": "Gravity forces $g(q)$",
     "T": "Kinetic energy $T$",
     "U": "Potential energy $U$",
     "L": "Lagrangian $L = T - U$",
     "tau": r"Joint forces $\tau = M \ddot q + C \dot q + g$",
 }
-_LHS = {"M": "M", "C": "C", "C_qd": r"(C\dot q)", "g": "g", "tau": r"\tau", "T": "T", "U": "U", "L": "L"}
+_LHS = {"M": "M", "C": "C", "C_v": r"(C\dot q)", "g": "g", "tau": r"\tau", "T": "T", "U": "U", "L": "L"}
 
 
 def _names(eom) -> dict:
     names = {}
     for k in range(eom.n):
         names[eom.q[k]] = f"q_{{{k + 1}}}"
-        names[eom.qd[k]] = rf"\dot{{q}}_{{{k + 1}}}"
-        names[eom.qdd[k]] = rf"\ddot{{q}}_{{{k + 1}}}"
+        names[eom.v[k]] = rf"\dot{{q}}_{{{k + 1}}}"
+        names[eom.a[k]] = rf"\ddot{{q}}_{{{k + 1}}}"
         s, c = eom.ring.trig_names(k)
         names[s], names[c] = f"s_{{{k + 1}}}", f"c_{{{k + 1}}}"
     return names

@@ -3,10 +3,11 @@
 A :class:`SymbolicModel` is a fixed-base tree of revolute and prismatic joints whose
 placements, joint axes, inertial parameters and gravity are sympy expressions (symbols or
 exact numbers). Body ``i`` hangs from body ``parent[i] < i``; its frame is placed in the
-parent frame at ``(R_tree[i], p_tree[i]) * X_J(q_i)`` exactly as in the numeric model, and
+parent frame at ``(X_tree_R[i], X_tree_p[i]) * X_J(q_i)`` exactly as in the numeric model, and
 its inertial parameters are ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` about the
 body origin in the body frame (``robodyn`` order). Joint ``k`` (1-based) has the coordinate
-``q{k}``, velocity ``qd{k}`` and acceleration ``qdd{k}``.
+``q{k}``, velocity ``qd{k}`` and acceleration ``qdd{k}`` (the tuples ``SymbolicModel.q``,
+``.v`` and ``.a``; the symbols print as q, q-dot and q-double-dot).
 
 Three ways to get one:
 
@@ -29,6 +30,7 @@ from typing import Sequence
 import numpy as np
 import sympy as sp
 
+from .._deprecated import renamed_attribute, renamed_keywords
 from .. import joints as J
 from ..errors import ModelError
 
@@ -96,36 +98,39 @@ def inertia_symbols(body: int) -> list[sp.Symbol]:
     return [sp.Symbol(f"{n}{body}", real=True) for n in PARAMETER_NAMES]
 
 
+OLD_FIELDS = dict(axis="joint_axis", R_tree="X_tree_R", p_tree="X_tree_p", inertia="theta")
+
+
 @dataclass(frozen=True)
 class SymbolicModel:
     """A fixed-base tree with sympy entries (see the module docstring).
 
     Per body ``i`` (``nb`` bodies, each with one joint): ``parent[i]`` (``-1``: the world),
-    ``joint_type[i]`` (``"revolute"`` or ``"prismatic"``), ``axis[i]`` (3 x 1, unit, body
-    frame), ``R_tree[i]`` (3 x 3) and ``p_tree[i]`` (3 x 1) (joint frame in the parent frame),
-    ``inertia[i]`` (10 parameters). Per joint: ``armature`` (rotor inertia on the diagonal of
+    ``joint_type[i]`` (``"revolute"`` or ``"prismatic"``), ``joint_axis[i]`` (3 x 1, unit,
+    body frame), ``X_tree_R[i]`` (3 x 3) and ``X_tree_p[i]`` (3 x 1) (joint frame in the parent
+    frame), ``theta[i]`` (10 inertial parameters): the names of :class:`robodyn.Model`. Per joint: ``armature`` (rotor inertia on the diagonal of
     ``M``). ``gravity`` (3 x 1, world frame). ``q``, ``qd``, ``qdd``: the joint symbols.
     """
 
     parent: tuple
     joint_type: tuple
-    axis: tuple
-    R_tree: tuple
-    p_tree: tuple
-    inertia: tuple
+    joint_axis: tuple
+    X_tree_R: tuple
+    X_tree_p: tuple
+    theta: tuple
     gravity: sp.Matrix
     armature: tuple = ()
     name: str = "robot"
     link_names: tuple = ()
     joint_names: tuple = ()
     q: tuple = field(init=False)
-    qd: tuple = field(init=False)
-    qdd: tuple = field(init=False)
+    v: tuple = field(init=False)
+    a: tuple = field(init=False)
 
     def __post_init__(self):
         nb = len(self.parent)
         set_ = lambda k, v: object.__setattr__(self, k, v)  # noqa: E731 (frozen dataclass)
-        for what in ("joint_type", "axis", "R_tree", "p_tree", "inertia"):
+        for what in ("joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta"):
             if len(getattr(self, what)) != nb:
                 raise ModelError(f"{what}: expected {nb} entries (one per body), got {len(getattr(self, what))}")
         for i, p in enumerate(self.parent):
@@ -133,13 +138,13 @@ class SymbolicModel:
                 raise ModelError(f"body {i}: parent index {p} must satisfy -1 <= parent < {i}")
             if self.joint_type[i] not in JOINT_TYPES:
                 raise ModelError(f"body {i}: joint type must be one of {JOINT_TYPES}, got {self.joint_type[i]!r}")
-            if len(self.inertia[i]) != 10:
-                raise ModelError(f"body {i}: expected 10 inertial parameters, got {len(self.inertia[i])}")
+            if len(self.theta[i]) != 10:
+                raise ModelError(f"body {i}: expected 10 inertial parameters, got {len(self.theta[i])}")
         set_("parent", tuple(int(p) for p in self.parent))
-        set_("axis", tuple(_vec(a, 3, f"axis[{i}]") for i, a in enumerate(self.axis)))
-        set_("R_tree", tuple(_mat3(R, f"R_tree[{i}]") for i, R in enumerate(self.R_tree)))
-        set_("p_tree", tuple(_vec(p, 3, f"p_tree[{i}]") for i, p in enumerate(self.p_tree)))
-        set_("inertia", tuple(tuple(exact(t) for t in th) for th in self.inertia))
+        set_("joint_axis", tuple(_vec(a, 3, f"joint_axis[{i}]") for i, a in enumerate(self.joint_axis)))
+        set_("X_tree_R", tuple(_mat3(R, f"X_tree_R[{i}]") for i, R in enumerate(self.X_tree_R)))
+        set_("X_tree_p", tuple(_vec(p, 3, f"X_tree_p[{i}]") for i, p in enumerate(self.X_tree_p)))
+        set_("theta", tuple(tuple(exact(t) for t in th) for th in self.theta))
         set_("gravity", _vec(self.gravity, 3, "gravity"))
         arm = tuple(exact(a) for a in self.armature) if self.armature else (sp.Integer(0),) * nb
         if len(arm) != nb:
@@ -148,8 +153,8 @@ class SymbolicModel:
         set_("link_names", tuple(self.link_names) or tuple(f"link{i + 1}" for i in range(nb)))
         set_("joint_names", tuple(self.joint_names) or tuple(f"joint{i + 1}" for i in range(nb)))
         set_("q", tuple(sp.Symbol(f"q{k + 1}", real=True) for k in range(nb)))
-        set_("qd", tuple(sp.Symbol(f"qd{k + 1}", real=True) for k in range(nb)))
-        set_("qdd", tuple(sp.Symbol(f"qdd{k + 1}", real=True) for k in range(nb)))
+        set_("v", tuple(sp.Symbol(f"qd{k + 1}", real=True) for k in range(nb)))
+        set_("a", tuple(sp.Symbol(f"qdd{k + 1}", real=True) for k in range(nb)))
 
     @property
     def nbodies(self) -> int:
@@ -161,27 +166,38 @@ class SymbolicModel:
 
     def inertial_parameters(self) -> list:
         """All inertial parameters (10 * nbodies), body after body."""
-        return [t for th in self.inertia for t in th]
+        return [t for th in self.theta for t in th]
 
     def parameters(self) -> list[sp.Symbol]:
         """The free symbols of the model (lengths, masses, ..., gravity), sorted by name;
         the joint symbols are not parameters."""
         syms = set(self.gravity.free_symbols)
         for i in range(self.nbodies):
-            for x in (self.axis[i], self.R_tree[i], self.p_tree[i]):
+            for x in (self.joint_axis[i], self.X_tree_R[i], self.X_tree_p[i]):
                 syms |= x.free_symbols
-            for t in (*self.inertia[i], self.armature[i]):
+            for t in (*self.theta[i], self.armature[i]):
                 syms |= t.free_symbols
         return sorted(syms, key=lambda s: s.name)
 
+    @renamed_keywords(**OLD_FIELDS)
     def replace(self, **changes) -> "SymbolicModel":
         """A new model with some fields changed."""
         return replace(self, **changes)
+
+    axis = renamed_attribute("axis", "joint_axis")
+    R_tree = renamed_attribute("R_tree", "X_tree_R")
+    p_tree = renamed_attribute("p_tree", "X_tree_p")
+    inertia = renamed_attribute("inertia", "theta")
+    qd = renamed_attribute("qd", "v")
+    qdd = renamed_attribute("qdd", "a")
 
     def __repr__(self) -> str:
         return (f"SymbolicModel {self.name!r}: {self.nbodies} bodies, joints "
                 f"{''.join('R' if t == 'revolute' else 'P' for t in self.joint_type)}, "
                 f"parameters {[s.name for s in self.parameters()]}")
+
+
+SymbolicModel.__init__ = renamed_keywords(**OLD_FIELDS)(SymbolicModel.__init__)
 
 
 def from_model(model) -> SymbolicModel:
@@ -201,10 +217,10 @@ def from_model(model) -> SymbolicModel:
     return SymbolicModel(
         parent=tuple(model.parent.tolist()),
         joint_type=tuple(J.NAMES[t] for t in model.joint_type),
-        axis=tuple([exact(a, snap=True) for a in ax] for ax in model.joint_axis),
-        R_tree=tuple(sp.Matrix(3, 3, [exact(x, snap=True) for x in R.ravel()]) for R in model.X_tree_R),
-        p_tree=tuple([exact(x) for x in p] for p in model.X_tree_p),
-        inertia=tuple([exact(x) for x in th] for th in model.inertia),
+        joint_axis=tuple([exact(a, snap=True) for a in ax] for ax in model.joint_axis),
+        X_tree_R=tuple(sp.Matrix(3, 3, [exact(x, snap=True) for x in R.ravel()]) for R in model.X_tree_R),
+        X_tree_p=tuple([exact(x) for x in p] for p in model.X_tree_p),
+        theta=tuple([exact(x) for x in th] for th in model.theta),
         gravity=[exact(x) for x in model.gravity],
         armature=tuple(exact(a) for a in model.armature),
         name=model.name,
@@ -219,7 +235,7 @@ def with_inertia_symbols(model) -> SymbolicModel:
     (1-based, :func:`inertia_symbols`); ``model.inertial_parameters()`` of the result is
     the parameter vector ``theta`` of ``tau = Y theta``."""
     sm = from_model(model)
-    return sm.replace(inertia=tuple(inertia_symbols(i + 1) for i in range(sm.nbodies)))
+    return sm.replace(theta=tuple(inertia_symbols(i + 1) for i in range(sm.nbodies)))
 
 
 def _rx(a) -> sp.Matrix:
@@ -288,7 +304,7 @@ def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Ra
         post_prev = post
     n = len(links)
     return SymbolicModel(
-        parent=tuple(range(-1, n - 1)), joint_type=tuple(types), axis=tuple([0, 0, 1] for _ in range(n)),
-        R_tree=tuple(R_tree), p_tree=tuple(p_tree), inertia=tuple(inertia), gravity=list(gravity),
+        parent=tuple(range(-1, n - 1)), joint_type=tuple(types), joint_axis=tuple([0, 0, 1] for _ in range(n)),
+        X_tree_R=tuple(R_tree), X_tree_p=tuple(p_tree), theta=tuple(inertia), gravity=list(gravity),
         armature=tuple(getattr(L, "armature", 0) for L in links), name=name,
     )

@@ -47,7 +47,7 @@ def recursion(rg) -> tuple[list, object]:
         Vi = [a + b for a, b in zip(motion_act_inv(rg, R, p, Vp), vJ)]
         c = motion_cross(rg, Vi, vJ)
         Ai = [a + x * rg.qdd[i] + b for a, x, b in zip(motion_act_inv(rg, R, p, Ap), Si, c)]
-        theta = rg.vec(m.inertia[i])
+        theta = rg.vec(m.theta[i])
         IV = inertia_mul(rg, theta, Vi)
         Fi = [a + b for a, b in zip(inertia_mul(rg, theta, Ai), force_cross(rg, Vi, IV))]
         T = T + rg.dot(Vi, IV) / 2 + rg.const(m.armature[i]) * rg.qd[i] ** 2 / 2

@@ -1,7 +1,7 @@
 """Generated code from the recursions: fast closed-form functions without expanded terms.
 
     M(q)          composite-rigid-body algorithm (:mod:`.crba`)
-    tau(q, qd, qdd), g(q) = tau(q, 0, 0), C_qd(q, qd) = tau(q, qd, 0) without gravity
+    tau(q, v, a), g(q) = tau(q, 0, 0), C_v(q, v) = tau(q, v, 0) without gravity
                   recursive Newton-Euler algorithm (:mod:`.newton_euler`)
 
 run once on symbols (:class:`._emit.Emitter`) and written as straight-line code, one
@@ -28,21 +28,21 @@ from .model import SymbolicModel, from_model
 # the terms with a recursion, and how each is evaluated
 RECURSIONS = {
     "M": "evaluated by the composite-rigid-body recursion",
-    "C_qd": "evaluated by the Newton-Euler recursion (qdd = 0, no gravity)",
-    "g": "evaluated by the Newton-Euler recursion (qd = qdd = 0)",
+    "C_v": "evaluated by the Newton-Euler recursion (a = 0, no gravity)",
+    "g": "evaluated by the Newton-Euler recursion (v = a = 0)",
     "tau": "evaluated by the Newton-Euler recursion",
 }
 
 
 def recursive_program(model: SymbolicModel, name: str) -> codegen.Program:
     """The straight-line :class:`~.codegen.Program` of term ``name`` (one of ``RECURSIONS``)."""
-    check_term(name, RECURSIONS)
+    name = check_term(name, RECURSIONS)
     n = model.nv
     if name == "M":
         em = Emitter(model)
         outputs, shape = [x for row in crba.mass_matrix(em) for x in row], (n, n)
     else:
-        moving = model.replace(gravity=[0, 0, 0]) if name == "C_qd" else model
+        moving = model.replace(gravity=[0, 0, 0]) if name == "C_v" else model
         em = Emitter(moving, rates=name != "g", accelerations=name == "tau")
         outputs, shape = newton_euler.recursion(em)[0], (n,)
     args, doc = signature(model, name, RECURSIONS[name])
@@ -50,10 +50,10 @@ def recursive_program(model: SymbolicModel, name: str) -> codegen.Program:
 
 
 class RecursiveDynamics(GeneratedCode):
-    """Generated functions of ``M``, ``C_qd``, ``g`` and ``tau`` of one model by the
+    """Generated functions of ``M``, ``C_v``, ``g`` and ``tau`` of one model by the
     recursions (module docstring), without deriving the expanded equations of motion."""
 
-    default_c_terms = ("M", "C_qd", "g", "tau")
+    default_c_terms = ("M", "C_v", "g", "tau")
 
     def __init__(self, model: SymbolicModel):
         self.model = model
@@ -65,26 +65,26 @@ class RecursiveDynamics(GeneratedCode):
         return f"RecursiveDynamics({self.model.name!r}, n={self.n})"
 
     def program(self, name: str, form: str = "auto") -> codegen.Program:
-        """The straight-line :class:`~.codegen.Program` of a term: ``"M"``, ``"C_qd"``,
+        """The straight-line :class:`~.codegen.Program` of a term: ``"M"``, ``"C_v"``,
         ``"g"`` or ``"tau"``. ``form`` is ``"auto"`` or ``"recursive"`` (the same here);
         expanded forms need :func:`.equations_of_motion`."""
         check_form(form)
         if form == "expanded":
             raise ValueError("form='expanded' needs the derived equations: use equations_of_motion(model)")
-        check_term(name, RECURSIONS)
+        name = check_term(name, RECURSIONS)
         if name not in self._programs:
             self._programs[name] = recursive_program(self.model, name)
         return self._programs[name]
 
 
 def recursive_dynamics(model) -> RecursiveDynamics:
-    """Fast generated code for ``M``, ``C_qd``, ``g`` and ``tau`` of ``model`` (a
+    """Fast generated code for ``M``, ``C_v``, ``g`` and ``tau`` of ``model`` (a
     :class:`robodyn.Model` with revolute and prismatic joints on a fixed base, or a
     :class:`SymbolicModel`) by the recursions, without the expanded derivation::
 
         rec = rd.symbolic.recursive_dynamics(rd.models.load("panda"))
         M = rec.to_numba("M")          # M(q): (..., 7, 7), one state in about a microsecond
-        rec.to_c("gen/")               # gen/panda_dynamics.{h,c}: panda_M, _C_qd, _g, _tau
+        rec.to_c("gen/")               # gen/panda_dynamics.{h,c}: panda_M, _C_v, _g, _tau
 
     The functions equal those of :meth:`.EquationsOfMotion.to_function` (which uses the
     same recursions for these terms by default).
