@@ -1,7 +1,8 @@
 """The single-state fast paths of rnea, aba, crba and coriolis_matrix (compiled for contiguous
 float64 vectors only) and the general path they fall back to: every other kind of input gives
-the same result, results written into ``out`` equal the returned ones, and the workspaces
-carved from one buffer never overrun it."""
+the same result (float32 input is converted to float64, and so is the result), results written
+into ``out`` equal the returned ones, and the workspaces carved from one buffer never overrun
+it."""
 
 from __future__ import annotations
 
@@ -24,8 +25,8 @@ CALLS = {
 
 
 def variants(x):
-    """The same vector as a list, a read-only array, a strided view, float32-exact values
-    and a (1, n) batch (whose result has a leading dimension of one)."""
+    """The same vector as a list, a read-only array, a strided view and a (1, n) batch (whose
+    result has a leading dimension of one); float32 input: see test_float32_input_is_computed_in_float64."""
     ro = x.copy()
     ro.flags.writeable = False
     strided = np.zeros(2 * x.size)[::2]
@@ -45,6 +46,32 @@ def test_every_input_kind_gives_the_fast_result(model, name):
             assert got.shape == (1,) + expected.shape
             got = got[0]
         assert_rel(got, expected, 1e-14, f"{name} with {kind} input")
+
+
+# float32 input carries a relative rounding of 2**-24 (6e-8) per entry; these well-conditioned
+# maps amplify it a few times (at most 4x measured on both models): the tolerance allows 50x.
+FLOAT32_TOL = 50 * 2.0 ** -24
+
+
+@pytest.mark.parametrize("model", MODELS, ids=["panda", "floating tree"])
+@pytest.mark.parametrize("name", list(CALLS))
+def test_float32_input_is_computed_in_float64(model, name):
+    """float32 arrays, one state and a batch of three, with and without ``out``: the result is
+    float64, equals the float64 call on the same (float32-rounded) values, and differs from the
+    call on the unrounded state only by the input rounding."""
+    call = CALLS[name]
+    for size in ((), (3,)):
+        state = random_state(model, np.random.default_rng(9), size)
+        f32 = [x.astype(np.float32) for x in state]
+        widened = [x.astype(np.float64) for x in f32]
+        got = call(model, *f32)
+        assert got.dtype == np.float64, f"{name}: {got.dtype} from float32 input"
+        assert_rel(got, call(model, *widened), 1e-14, f"{name}: float32 vs the same values in float64")
+        assert_rel(got, call(model, *state), FLOAT32_TOL, f"{name}: float32 vs unrounded float64")
+        if name in OUT_CALLS:
+            out = np.full(got.shape, np.nan)
+            assert OUT_CALLS[name](model, *f32, out=out) is out
+            assert_rel(out, got, 1e-15, f"{name} into out from float32 input")
 
 
 @pytest.mark.parametrize("name", ["rnea", "aba", "crba"])

@@ -1,6 +1,7 @@
 """Hybrid dynamics (robodyn.hybrid_dynamics): rnea and aba at the two extremes, a partitioned
 solve of the equation of motion in between (random trees and example-robot-data URDFs with
-Pinocchio's M and h), the two-link arm in closed form, batches, singular bodies and bad input."""
+Pinocchio's M and h; external wrenches in the three frames against Pinocchio's rnea and aba),
+the two-link arm in closed form, batches, singular bodies and bad input."""
 
 from __future__ import annotations
 
@@ -12,6 +13,7 @@ import robodyn as rd
 from helpers import (F_EXT_FRAMES, PLANAR_2R, assert_rel, massless_leaf_model, planar_2r, planar_2r_terms,
                      random_models, rng_for, states, with_friction_and_armature)
 from robodyn import joints as J
+from test_pinocchio import _pin_forces
 from urdf_subset import load_pair, pairs
 
 
@@ -117,6 +119,29 @@ def test_urdf_against_pinocchio_terms(path, floating_base):
     assert_rel(tau_out, pin.rnea(pm, data, qp, v, a), 1e-9, "all known")
     a_out, _ = rd.hybrid_dynamics(model, q, v, a, tau_known, np.zeros(model.nv, bool), friction=False)
     assert_rel(a_out, pin.aba(pm, data, qp, v, tau_known), 1e-9, "none known")
+
+
+@pytest.mark.parametrize("path, floating_base", pairs())
+def test_urdf_external_wrenches_against_pinocchio(path, floating_base):
+    """On real robots, with a wrench on every body in each frame (converted to Pinocchio's
+    joint-frame forces by Pinocchio's placements): the given entries are kept, Pinocchio's
+    rnea at the completed acceleration gives the completed forces, and Pinocchio's aba at the
+    completed forces gives the completed acceleration."""
+    pair = load_pair(path, floating_base)
+    model, pm, data = pair.model, pair.pm, pair.data
+    for frame in F_EXT_FRAMES:
+        q, v, a = states(model, "urdf f_ext", frame)
+        rng = rng_for(path, floating_base, "f_ext", frame)
+        mask, tau_known = random_mask(model, rng), rng.standard_normal(model.nv)
+        f_ext = rng.standard_normal((model.nbodies, 6))
+        qp = pair.pin_q(q)
+        pin.forwardKinematics(pm, data, qp)
+        forces = _pin_forces(pm, f_ext, data, frame)
+        a_out, tau_out = rd.hybrid_dynamics(model, q, v, np.where(mask, a, np.nan), np.where(mask, np.nan, tau_known),
+                                            mask, f_ext, frame, friction=False)
+        assert np.array_equal(a_out[mask], a[mask]) and np.array_equal(tau_out[~mask], tau_known[~mask])
+        assert_rel(tau_out, pin.rnea(pm, data, qp, v, a_out, forces), 1e-9, f"tau, {frame}")
+        assert_rel(a_out, pin.aba(pm, data, qp, v, tau_out, forces), 1e-9, f"a, {frame}")
 
 
 def test_batch_matches_single_states():

@@ -1,5 +1,10 @@
-"""Terms of the equation of motion (robodyn.gravity, nonlinear_effects, generalized_momentum):
-against rnea and crba, the two-link planar arm's gravity vector, batches and bad input; their
+"""Terms of the equation of motion (robodyn.gravity, nonlinear_effects, generalized_momentum).
+
+gravity and nonlinear_effects run the RNEA kernel itself (at v = a = 0, and at a = 0): the tests
+named ``..._is_wired_to_rnea...`` only check that wiring (options passed on, friction and
+armature left out). The checks of their values are independent: the equation of motion with
+crba and coriolis_matrix (other kernels), the two-link planar arm in closed form here, and
+Pinocchio's gravity and nonlinear effects in test_pinocchio.py. Also batches and bad input; their
 derivatives (gravity_derivatives, ...) against Richardson differences, batches and bad input."""
 
 from __future__ import annotations
@@ -14,7 +19,8 @@ from helpers import (FD_TOL, PLANAR_2R, assert_rel, check_batch, check_input_val
 
 
 @random_models
-def test_gravity_is_rnea_at_rest(model):
+def test_gravity_is_wired_to_rnea_at_rest(model):
+    """Wiring: gravity(q) is the RNEA kernel at v = a = 0, without friction or armature."""
     m = with_friction_and_armature(model, rng_for(model.name))
     q, _, _ = states(m)
     z = np.zeros(m.nv)
@@ -23,7 +29,8 @@ def test_gravity_is_rnea_at_rest(model):
 
 
 @random_models
-def test_nonlinear_effects_is_rnea_without_acceleration(model):
+def test_nonlinear_effects_is_wired_to_rnea_without_acceleration(model):
+    """Wiring: nonlinear_effects(q, v) is the RNEA kernel at a = 0, without friction or armature."""
     m = with_friction_and_armature(model, rng_for(model.name))
     q, v, _ = states(m)
     assert_rel(rd.nonlinear_effects(m, q, v), rd.rnea(m, q, v, np.zeros(m.nv), friction=False), 1e-12)
@@ -41,7 +48,8 @@ def test_generalized_momentum_is_mass_matrix_times_v(model):
 
 @random_models
 def test_equation_of_motion(model):
-    """rnea == M a + nonlinear_effects, nonlinear_effects == C v + g."""
+    """rnea == M a + nonlinear_effects, nonlinear_effects == C v + g (crba and coriolis_matrix
+    run kernels of their own)."""
     q, v, a = states(model)
     assert_rel(rd.rnea(model, q, v, a), rd.crba(model, q) @ a + rd.nonlinear_effects(model, q, v), 1e-9)
     assert_rel(rd.nonlinear_effects(model, q, v), rd.coriolis_matrix(model, q, v) @ v + rd.gravity(model, q), 1e-9)

@@ -6,6 +6,7 @@ import functools
 import pathlib
 import re
 import warnings
+import xml.etree.ElementTree as ET
 
 import numpy as np
 import pinocchio as pin
@@ -21,14 +22,92 @@ from conftest import assert_names_line, erd_id, example_robot_urdfs, marked_line
 # example-robot-data, compared with Pinocchio
 # ----------------------------------------------------------------------------------------
 
-# Published URDFs with a moving body no rigid body can be, even after fixed joints merge its
-# links (inertia not positive semi-definite, or principal moments violating I1 + I2 >= I3).
-# robodyn refuses them by default, naming the first such body and its links with their numbers,
-# and loads them with physical="warn". Found by loading every file of example-robot-data.
-UNPHYSICAL = {  # file -> (body, its first link): bodies no rigid body can be, even merged
-    "romeo_description/urdf/romeo_laas_small.urdf": ("LHipPitch_link", "LHipPitch_link"),
-    "romeo_description/urdf/romeo_small.urdf": ("RShoulderYawLink", "RShoulderYawLink"),
-}
+# Whether a URDF's moving bodies are rigid bodies, from its own <inertial> values (the
+# reference UNPHYSICAL below is derived with).
+
+
+def _numbers(element, attribute: str, default) -> np.ndarray:
+    text = element.get(attribute) if element is not None else None
+    return np.array([float(x) for x in text.split()] if text else default, dtype=float)
+
+
+def _origin(element) -> tuple[np.ndarray, np.ndarray]:
+    """``(R, p)`` of the <origin> child of ``element`` (URDF rpy: extrinsic x, y, z)."""
+    origin = element.find("origin") if element is not None else None
+    return (Rotation.from_euler("xyz", _numbers(origin, "rpy", [0.0, 0.0, 0.0])).as_matrix(),
+            _numbers(origin, "xyz", [0.0, 0.0, 0.0]))
+
+
+def _link_inertial(link) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(m, c, I_c)`` of a <link> in its own frame (zeros without <inertial>)."""
+    inertial = link.find("inertial")
+    if inertial is None:
+        return 0.0, np.zeros(3), np.zeros((3, 3))
+    R, c = _origin(inertial)
+    mass = inertial.find("mass")
+    m = float(mass.get("value")) if mass is not None else 0.0
+    el = inertial.find("inertia")
+    g = {k: float(el.get(k, 0.0)) if el is not None else 0.0 for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    Ic = np.array([[g["ixx"], g["ixy"], g["ixz"]], [g["ixy"], g["iyy"], g["iyz"]], [g["ixz"], g["iyz"], g["izz"]]])
+    return m, c, R @ Ic @ R.T
+
+
+# A violation counts beyond 1e-6 of the largest principal moment plus 1e-12 kg m^2 (the
+# rounding of published values: iCub's point masses carry moments of 1e-35 and
+# near-violations of 1e-18 kg m^2); the bodies found violate by 1e-3 or more of it.
+_INERTIA_RTOL, _INERTIA_ATOL = 1e-6, 1e-12
+
+
+def _is_rigid_body(m: float, h: np.ndarray, Io: np.ndarray) -> bool:
+    """Mass ``m``, first moment ``h`` and inertia ``Io`` about the body origin of a rigid body?"""
+    if m < 0:
+        return False
+    if m == 0:
+        return not np.any(h) and not np.any(Io)
+    c = h / m
+    lam = np.linalg.eigvalsh(Io - m * (c @ c * np.eye(3) - np.outer(c, c)))
+    tol = _INERTIA_RTOL * np.abs(lam).max() + _INERTIA_ATOL
+    return lam[0] >= -tol and lam[0] + lam[1] >= lam[2] - tol
+
+
+def unphysical_bodies(source, floating_base: bool = False) -> list[tuple[str, list[str]]]:
+    """``[(body, links)]`` of the moving bodies of a URDF (file or text) that are no rigid
+    body, in depth-first order (children ordered by joint name, as urdfdom orders them). A body
+    is the child link of a moving joint (or the root link, on a floating base) with every link
+    fixed joints attach to it, their inertials summed about the body origin (parallel-axis
+    theorem). Written from the URDF specification with ElementTree, independently of robodyn."""
+    text = pathlib.Path(source).read_text() if isinstance(source, pathlib.Path) else source
+    root = ET.fromstring(text)
+    links = {link.get("name"): _link_inertial(link) for link in root.findall("link")}
+    children: dict[str, list] = {name: [] for name in links}
+    has_parent = set()
+    for joint in sorted(root.findall("joint"), key=lambda j: j.get("name")):
+        children[joint.find("parent").get("link")].append(joint)
+        has_parent.add(joint.find("child").get("link"))
+    roots = [name for name in links if name not in has_parent]
+    if len(roots) != 1:
+        return []
+    bodies: dict[str, list] = {}  # body -> [m, h, Io, links], in depth-first order
+    stack = [(roots[0], roots[0] if floating_base else None, np.eye(3), np.zeros(3))]
+    while stack:
+        link, body, R, p = stack.pop()
+        if body is not None:
+            m, c, Ic = links[link]
+            cb = p + R @ c
+            acc = bodies.setdefault(body, [0.0, np.zeros(3), np.zeros((3, 3)), []])
+            acc[0] += m
+            acc[1] += m * cb
+            acc[2] += R @ Ic @ R.T + m * (cb @ cb * np.eye(3) - np.outer(cb, cb))
+            acc[3].append(link)
+        for joint in reversed(children[link]):
+            child = joint.find("child").get("link")
+            Rj, pj = _origin(joint)
+            if joint.get("type") == "fixed":
+                stack.append((child, body, R @ Rj, p + R @ pj))
+            else:
+                stack.append((child, child, np.eye(3), np.zeros(3)))
+    return [(b, acc[3]) for b, acc in bodies.items() if not _is_rigid_body(*acc[:3])]
+
 
 # Files with placeholder links (a massless base or foot with an inertia, a sensor mount) that
 # are not rigid bodies alone, but merge by fixed joints into consistent bodies: they load.
@@ -59,10 +138,54 @@ ALL_URDFS = example_robot_urdfs()
 PIN_URDFS = [p for p in ALL_URDFS if erd_id(p) not in PINOCCHIO_REFUSES]
 
 
+@functools.lru_cache(maxsize=None)
+def _unphysical(path: pathlib.Path, floating_base: bool) -> list[tuple[str, list[str]]]:
+    return unphysical_bodies(path, floating_base)
+
+
+# Published URDFs with a moving body no rigid body can be, even after fixed joints merge its
+# links (inertia about the centre of mass not positive semi-definite, principal moments
+# violating I1 + I2 >= I3, or an inertia without mass). robodyn refuses them by default, naming
+# the first such body and its links with their numbers, and loads them with physical="warn".
+# file -> [(body, its links)] on a fixed base, in depth-first order, by unphysical_bodies.
+UNPHYSICAL = {erd_id(p): bodies for p in PIN_URDFS if (bodies := _unphysical(p, False))}
+
+
 def test_example_robot_data_is_found():
     assert len(ALL_URDFS) >= 60
     known = {erd_id(p) for p in ALL_URDFS}
-    assert set(UNPHYSICAL) <= known and set(PLACEHOLDERS) <= known and set(PINOCCHIO_REFUSES) <= known
+    assert set(PLACEHOLDERS) <= known and set(PINOCCHIO_REFUSES) <= known
+    assert UNPHYSICAL and not set(UNPHYSICAL) & set(PLACEHOLDERS)  # some files to test, placeholders load
+
+
+@pytest.mark.parametrize("name, body", [("triangle_inequality.urdf", "arm"), ("inertia_not_psd.urdf", "arm"),
+                                        ("zero_mass_with_inertia.urdf", "arm"), ("negative_mass.urdf", "arm")])
+def test_unphysical_bodies_finds_the_bad_fixtures(fixture_path, name, body):
+    """The criterion behind UNPHYSICAL flags the body of each bad-inertia fixture."""
+    assert unphysical_bodies(fixture_path(name)) == [(body, [body])]
+
+
+def test_unphysical_bodies_merges_fixed_links():
+    """Links joined by a fixed joint are judged together: two point masses make a thin rod
+    (moments 0, 0.5, 0.5: I1 + I2 = I3 exactly); a massless link with an inertia is fine merged,
+    not as a body of its own; a light point mass does not repair a flat inertia (0.1, 0.1, 0.5)."""
+    def robot(arm, tip, tip_joint="fixed"):
+        return (f'<robot name="r"><link name="base"/>{arm}{tip}'
+                '<joint name="j" type="revolute"><parent link="base"/><child link="arm"/></joint>'
+                f'<joint name="f" type="{tip_joint}"><parent link="arm"/><child link="tip"/>'
+                '<origin xyz="1 0 0"/></joint></robot>')
+
+    def link(name, m, ixx=0.0, iyy=0.0, izz=0.0):
+        return (f'<link name="{name}"><inertial><mass value="{m}"/>'
+                f'<inertia ixx="{ixx}" iyy="{iyy}" izz="{izz}" ixy="0" ixz="0" iyz="0"/></inertial></link>')
+
+    assert unphysical_bodies(robot(link("arm", 1), link("tip", 1))) == []
+    massless = link("tip", 0, 1e-3, 1e-3, 1e-3)
+    assert unphysical_bodies(robot(link("arm", 1, 0.1, 0.1, 0.1), massless)) == []
+    assert unphysical_bodies(robot(link("arm", 1, 0.1, 0.1, 0.1), massless, "revolute")) == [("tip", ["tip"])]
+    flat = robot(link("arm", 1, 0.1, 0.1, 0.5), link("tip", 1e-3))
+    assert unphysical_bodies(flat) == [("arm", ["arm", "tip"])]
+    assert unphysical_bodies(flat, floating_base=True) == [("arm", ["arm", "tip"])]  # the massless base is fine
 
 
 @functools.lru_cache(maxsize=None)
@@ -80,8 +203,8 @@ def _load_quietly(path, **kw) -> rd.Model:
         return rd.load_urdf(path, **kw)
 
 
-def _physical(path) -> str:
-    return "warn" if erd_id(path) in UNPHYSICAL else "error"
+def _physical(path, floating_base: bool = False) -> str:
+    return "warn" if _unphysical(path, floating_base) else "error"
 
 
 def _theta_from_pinocchio(inertia: pin.Inertia) -> np.ndarray:
@@ -109,7 +232,7 @@ def _assert_matches_pinocchio(model: rd.Model, pm: pin.Model) -> None:
     assert model.total_mass == pytest.approx(pm_mass, rel=1e-12, abs=1e-300)
     for j in range(1, pm.njoints):
         i = model.body_joint_names.index(pm.names[j])
-        _assert_close_groups(model.inertia[i], _theta_from_pinocchio(pm.inertias[j]), f"body of {pm.names[j]}")
+        _assert_close_groups(model.theta[i], _theta_from_pinocchio(pm.inertias[j]), f"body of {pm.names[j]}")
         placement = pm.jointPlacements[j]
         np.testing.assert_allclose(model.X_tree_R[i], placement.rotation, rtol=0, atol=1e-12)
         np.testing.assert_allclose(model.X_tree_p[i], placement.translation, rtol=0, atol=1e-12)
@@ -136,7 +259,7 @@ def test_example_robot_data_matches_pinocchio(path):
 @pytest.mark.parametrize("path", PIN_URDFS, ids=erd_id)
 def test_example_robot_data_floating_base_matches_pinocchio(path):
     pm = _pin_model(str(path), True)
-    model = _load_quietly(path, floating_base=True, physical=_physical(path))
+    model = _load_quietly(path, floating_base=True, physical=_physical(path, True))
     assert model.floating_base and model.body_joint_names[0] == "root_joint"
     _assert_matches_pinocchio(model, pm)
     assert list(model.joint_names) == list(pm.names[2:])
@@ -144,20 +267,26 @@ def test_example_robot_data_floating_base_matches_pinocchio(path):
 
 @pytest.mark.parametrize("rel", sorted(UNPHYSICAL))
 def test_unphysical_example_robot_data_refused_then_loaded_with_warning(rel):
+    """robodyn refuses the file naming the first unphysical body (depth first) and its links,
+    and with physical="warn" warns about each unphysical body, fixed and floating base."""
     path = next(p for p in ALL_URDFS if erd_id(p) == rel)
-    body, link = UNPHYSICAL[rel]
+    (body, links), *_ = UNPHYSICAL[rel]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
         with pytest.raises(rd.ModelError) as err:
             rd.load_urdf(path)
     msg = str(err.value)
-    assert str(path) in msg and f"body {body!r}" in msg and f"<link name={link!r}>" in msg and "line " in msg
-    assert "principal moments" in msg and "mass " in msg  # the numbers
+    assert str(path) in msg and f"body {body!r}" in msg and "line " in msg
+    assert all(f"<link name={link!r}>" in msg for link in links), msg
+    assert ("principal moments" in msg and "mass " in msg) or "zero mass" in msg  # the numbers
     assert "physical='warn'" in msg  # says how to load it anyway
-    with pytest.warns(rd.RobodynWarning) as record:
-        model = rd.load_urdf(path, physical="warn")
-    assert any(f"body {body!r}" in str(w.message) and "kept as given" in str(w.message) for w in record)
-    assert model.physical == "warn"
+    for floating_base in (False, True):
+        with pytest.warns(rd.RobodynWarning) as record:
+            model = rd.load_urdf(path, physical="warn", floating_base=floating_base)
+        warned = [re.match(r".*?: body '([^']+)'", str(w.message)).group(1) for w in record
+                  if "kept as given" in str(w.message)]
+        assert warned == [b for b, _ in _unphysical(path, floating_base)]
+        assert model.physical == "warn"
 
 
 @pytest.mark.parametrize("rel", sorted(PLACEHOLDERS))
@@ -362,7 +491,7 @@ def test_valid_robot_loads_without_warning():
 
 def test_link_without_inertial_is_massless():
     model = rd.load_urdf(_robot(_link("base"), _link("arm"), _joint("j", "revolute", "base", "arm")))
-    np.testing.assert_array_equal(model.inertia, np.zeros((1, 10)))
+    np.testing.assert_array_equal(model.theta, np.zeros((1, 10)))
     assert model.total_mass == 0.0
 
 
@@ -438,7 +567,7 @@ def test_inertial_origin_rotation_is_R_I_RT():
                   _joint("j", "revolute", "base", "arm"))
     model = rd.load_urdf(text)
     R = rot("z", RPY[2]) @ rot("y", RPY[1]) @ rot("x", RPY[0])
-    np.testing.assert_allclose(model.inertia[0], _theta(2.5, com, R @ I_MAT @ R.T), rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(model.theta[0], _theta(2.5, com, R @ I_MAT @ R.T), rtol=1e-13, atol=1e-15)
 
 
 def test_joint_origin_rpy_and_xyz():
@@ -466,7 +595,7 @@ def test_fixed_joint_merges_child_inertia_by_parallel_axis():
     # by hand: both bodies about arm's origin, in arm's frame, then added
     c2_arm = p + R @ c2
     expected = _theta(m1, c1, I1) + _theta(m2, c2_arm, R @ I_MAT @ R.T)
-    np.testing.assert_allclose(model.inertia[0], expected, rtol=1e-13, atol=1e-15)
+    np.testing.assert_allclose(model.theta[0], expected, rtol=1e-13, atol=1e-15)
     # the merged link stays a frame of the model, at its placement on the body
     body, Rf, pf = model.frame_index("tool")
     assert body == 0
@@ -551,7 +680,7 @@ def test_floating_base_layout():
     assert (model.nq, model.nv) == (7 + n, 6 + n)
     assert model.joint_names == fixed.joint_names == ("shoulder",)
     assert (model.idx_q[1], model.idx_v[1]) == (7, 6)
-    np.testing.assert_allclose(model.inertia[0], _theta(10.0, [0, 0, 0], np.diag([0.01, 0.02, 0.03]))
+    np.testing.assert_allclose(model.theta[0], _theta(10.0, [0, 0, 0], np.diag([0.01, 0.02, 0.03]))
                                + _theta(0.5, [0, 0, 0.3], np.diag([0.01, 0.02, 0.03])), atol=1e-15)
     assert model.frame_index("head")[0] == 0
     assert np.all(np.isinf(model.lower[:6])) and np.all(np.isinf(model.upper[:6]))
@@ -568,7 +697,7 @@ _ARM = (_link("base", 2.0) + _link("arm", 1.0, xyz="0.1 0 0.2")
 
 
 def _same_model(a, b):
-    for field in ("parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "inertia", "lower", "upper"):
+    for field in ("parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta", "lower", "upper"):
         np.testing.assert_array_equal(getattr(a, field), getattr(b, field), err_msg=field)
     assert a.link_names == b.link_names and a.joint_names == b.joint_names
 

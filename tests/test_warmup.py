@@ -2,6 +2,8 @@
 
 import inspect
 
+import numpy as np
+
 import robodyn as rd
 from robodyn import _warmup as W
 
@@ -20,3 +22,22 @@ def test_progress_reports_each_step_then_the_end(monkeypatch):
     rd.warmup(progress=lambda done, total, name: seen.append((done, total, name)))
     assert calls == ["a", "b"]
     assert seen == [(0, 2, "a"), (1, 2, "b"), (2, 2, "")]
+
+
+def test_warmup_runs_real_steps_silently(monkeypatch):
+    """``rd.warmup()`` with its defaults (no progress callback) runs real steps, each once and in
+    order; three of them keep it cheap."""
+    chosen = ["rnea (fixed base, one state)", "aba (floating base, batch)", "crba (floating base, one state)"]
+    real = dict(W.steps())
+    ran = []
+
+    def recorded(name):
+        def call():
+            ran.append((name, real[name]()))
+        return call
+
+    monkeypatch.setattr(W, "steps", lambda: [(name, recorded(name)) for name in chosen])
+    assert rd.warmup() is None
+    assert [name for name, _ in ran] == chosen
+    for name, result in ran:
+        assert np.all(np.isfinite(result)), name
