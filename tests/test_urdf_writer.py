@@ -62,14 +62,19 @@ def test_random_tree_round_trip(seed, floating_base):
 
 
 def test_written_file_and_unbounded_joints(tmp_path):
-    """A file path; revolute joints without limits are continuous, prismatic ones have no <limit>."""
+    """A file path; revolute joints without limits are continuous (no <limit>), prismatic ones
+    have a <limit> of +-the largest double, which reads back as no limit."""
     model = random_model(4, seed=5)
     path = tmp_path / "robot.urdf"
     text = rd.write_urdf(model, path)
     assert path.read_text() == text
-    assert text.count('type="continuous"') + text.count('type="prismatic"') == 4
-    assert "<limit" not in text
+    prismatic = text.count('type="prismatic"')
+    assert text.count('type="continuous"') + prismatic == 4 and prismatic > 0
+    assert text.count('<limit lower="-1.7976931348623157e+308" upper="1.7976931348623157e+308" '
+                      'velocity="1.7976931348623157e+308" effort="1.7976931348623157e+308"/>') == prismatic
     back = rd.load_urdf(path)
+    for key in ("lower", "upper", "velocity_limit", "effort_limit"):
+        np.testing.assert_array_equal(getattr(back, key), getattr(model, key), err_msg=key)
     q, v, a = states(model, "file")
     assert_rel(rd.rnea(back, q, v, a), rd.rnea(model, q, v, a), 1e-12)
 
@@ -122,3 +127,49 @@ def test_planar_joints_round_trip():
     q, v, a = states(model, "planar", size=2)
     pq, pv = _permutations(model, back)
     assert_rel(rd.rnea(back, q[:, pq], v[:, pv], a[:, pv]), rd.rnea(model, q, v, a)[:, pv], 1e-12)
+
+
+def _pinocchio_reads(model):
+    """Pinocchio's model of ``write_urdf(model)`` (free flyer for a floating base), a function
+    mapping ``model``'s configuration to Pinocchio's (a continuous joint is ``(cos, sin)``
+    there), and the map of Pinocchio's v entries into ``model``'s (joints matched by name)."""
+    import pinocchio as pin
+
+    text = rd.write_urdf(model)
+    pm = pin.buildModelFromXML(text, pin.JointModelFreeFlyer()) if model.floating_base else pin.buildModelFromXML(text)
+    parts, pv = [], []
+    for j in range(1, pm.njoints):
+        name = pm.names[j]
+        i = 0 if (model.floating_base and name == "root_joint") else model.body_joint_names.index(name)
+        nq, nv = J.NQ[model.joint_type[i]], J.NV[model.joint_type[i]]
+        assert pm.joints[j].nv == nv, name
+        first = model.idx_q[i]
+        if pm.joints[j].nq == nq:
+            parts.append(lambda q, s=slice(first, first + nq): q[s])
+        else:  # continuous: Pinocchio's (cos, sin) of robodyn's angle
+            assert (pm.joints[j].nq, nq) == (2, 1), name
+            parts.append(lambda q, k=first: np.array([np.cos(q[k]), np.sin(q[k])]))
+        pv += list(range(model.idx_v[i], model.idx_v[i] + nv))
+    return pm, (lambda q: np.concatenate([f(q) for f in parts])), np.array(pv, dtype=int)
+
+
+@pytest.mark.parametrize("model", [rd.models.load("panda"), rd.models.load("puma560"), rd.models.load("scara"),
+                                   random_model(9, seed=3, floating_base=False, branching=0.6),
+                                   random_model(9, seed=4, floating_base=True, branching=0.6)],
+                         ids=["panda", "puma560", "scara", "tree", "floating-tree"])
+def test_pinocchio_reads_what_it_writes(model):
+    """Another library reads the written file to the same dynamics: Pinocchio's rnea and mass
+    matrix of ``write_urdf(model)`` equal robodyn's of the model (friction and armature, which
+    Pinocchio's rnea leaves out, off)."""
+    import pinocchio as pin
+
+    model = model.replace(armature=np.zeros(model.nv))
+    pm, to_pin, pv = _pinocchio_reads(model)
+    data = pm.createData()
+    q, v, a = states(model, "pin-writer", size=3)
+    expected = rd.rnea(model, q, v, a, friction=False)
+    M = rd.crba(model, q)
+    for k in range(3):
+        assert_rel(pin.rnea(pm, data, to_pin(q[k]), v[k, pv], a[k, pv]), expected[k, pv], 1e-10, f"rnea {k}")
+        Mp = pin.crba(pm, data, to_pin(q[k]))
+        assert_rel(np.triu(Mp) + np.triu(Mp, 1).T, M[k][np.ix_(pv, pv)], 1e-10, f"crba {k}")

@@ -5,7 +5,8 @@ revolute, continuous, prismatic, fixed (merged into the parent body), floating (
 joint; its parent link must be the root or welded to it) and planar (with ``<axis xyz="0 0
 1">``, the plane's normal), with ``<origin>``,
 ``<axis>`` (normalised; zero is an error), ``<limit lower upper velocity effort>`` (lower and
-upper default to 0 as in the URDF specification; a joint without ``<limit>`` is unbounded,
+upper default to 0 as in the URDF specification; +-1.7976931348623157e+308, the largest
+double, is no limit, as ``write_urdf`` writes it; a joint without ``<limit>`` is unbounded,
 continuous joints always are), ``<dynamics damping friction>``.
 ``<mimic>`` joints load as independent joints with a warning. Elements without rigid-body
 dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
@@ -44,6 +45,14 @@ MAX_FILE_BYTES = 64 * 1024 * 1024
 
 def _read_source(source) -> tuple[str, str]:
     return read_source(source, "URDF", MAX_FILE_BYTES)
+
+
+NO_LIMIT = float(np.finfo(float).max)  # "no limit" in a file (URDF has no infinity; write_urdf's)
+
+
+def _no_limit(x: float) -> float:
+    """A limit of +-the largest double is no limit (+-inf)."""
+    return math.copysign(math.inf, x) if abs(x) >= NO_LIMIT else x
 
 
 def _child(elem, tag: str):
@@ -249,13 +258,13 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
         # URDF: lower and upper default to 0 in a <limit> (urdfdom and Pinocchio read it so);
         # without a <limit> element robodyn leaves the joint unbounded.
         for key in ("lower", "upper"):
-            kw[key] = rd.floats(lim, key, 1, (0.0,))[0]
+            kw[key] = _no_limit(rd.floats(lim, key, 1, (0.0,))[0])
         if kw["lower"] > kw["upper"] and jtype != "continuous":
             # PyBullet reads such a limit as no limit; robodyn does too, and says so
             reversed_limits.append(f"{jname} ({kw.pop('lower'):g} > {kw.pop('upper'):g})")
         for key in ("velocity", "effort"):
             if lim.get(key) is not None:
-                kw[key] = rd.floats(lim, key, 1)[0]
+                kw[key] = _no_limit(rd.floats(lim, key, 1)[0])
     if dyn is not None:
         for key in ("damping", "friction"):
             if dyn.get(key) is not None:

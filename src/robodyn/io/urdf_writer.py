@@ -3,7 +3,11 @@
 Each body becomes a link (its ``<inertial>`` at the centre of mass, axes of the body frame,
 mass-less bodies without ``<inertial>``) and each joint a revolute, continuous (a revolute
 joint without position limits), or prismatic joint with its placement (``rpy`` extrinsic
-X-Y-Z, ``R = Rz Ry Rx``), axis, ``<limit>`` and ``<dynamics damping friction>``. Frames (links
+X-Y-Z, ``R = Rz Ry Rx``), axis, ``<limit>`` and ``<dynamics damping friction>``. A revolute or
+prismatic joint's ``<limit>`` always carries ``lower``, ``upper``, ``effort`` and
+``velocity`` (urdfdom, hence Pinocchio and ROS, refuse it otherwise); URDF has no infinity,
+so "no limit" is written as the largest double, ``1.7976931348623157e+308`` (with its
+sign), which ``load_urdf`` reads back as no limit. Frames (links
 merged into bodies) become mass-less links on fixed joints. A fixed base's root link keeps
 its name (the model's frame attached to the world); a floating base's root link is body 0,
 and the file must be loaded with ``floating_base=True``. Other free joints (bodies flying
@@ -12,9 +16,8 @@ joints beside a floating base, raise ``ValueError``. Numbers are written with ``
 (exact round trip).
 
 What URDF cannot hold is reported with a :class:`RobodynWarning`: armature, Coulomb
-smoothing, a gravity other than ``(0, 0, -9.81)`` (``load_urdf(gravity=...)`` sets it), and
-velocity/effort limits of a prismatic joint without position limits. A one-sided position
-limit raises ``ValueError``.
+smoothing, and a gravity other than ``(0, 0, -9.81)`` (``load_urdf(gravity=...)`` sets it). A
+one-sided position limit raises ``ValueError``.
 """
 
 from __future__ import annotations
@@ -70,6 +73,14 @@ def _link_and_joint(model, i: int, kind: str, parent: str) -> list[str]:
             f"  <joint name={quoteattr(model.body_joint_names[i])} type=\"{kind}\">",
             f"    <parent link={quoteattr(parent)}/>", f"    <child link={quoteattr(model.link_names[i])}/>",
             f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}"]
+
+
+NO_LIMIT = float(np.finfo(float).max)  # URDF has no infinity: the largest double means "no limit"
+
+
+def _finite(x: float) -> float:
+    """``x``, or +-NO_LIMIT for +-inf."""
+    return float(x) if np.isfinite(x) else float(np.copysign(NO_LIMIT, x))
 
 
 def write_urdf(model, path=None) -> str:
@@ -129,14 +140,13 @@ def write_urdf(model, path=None) -> str:
         kind = ("revolute" if bounded else "continuous") if jt == J.REVOLUTE else "prismatic"
         lines += _link_and_joint(model, i, kind, link_of(model.parent[i]))
         lines.append(f'    <axis xyz="{_num(model.joint_axis[i])}"/>')
-        attrs = f'lower="{_num(lo)}" upper="{_num(hi)}" ' if bounded else ""
-        for key, val in (("velocity", model.velocity_limit[k]), ("effort", model.effort_limit[k])):
-            if np.isfinite(val):
-                attrs += f'{key}="{_num(val)}" '
-        if bounded or (kind == "continuous" and attrs):
-            lines.append(f"    <limit {attrs.strip()}/>")
-        elif attrs:
-            lost.append(f"velocity/effort limits of the unbounded prismatic joint {model.body_joint_names[i]!r}")
+        rates = (("velocity", model.velocity_limit[k]), ("effort", model.effort_limit[k]))
+        if kind == "continuous":  # a <limit> is optional: only the finite rates
+            attrs = " ".join(f'{key}="{_num(val)}"' for key, val in rates if np.isfinite(val))
+        else:  # required, with all four attributes
+            attrs = " ".join(f'{key}="{_num(_finite(val))}"' for key, val in (("lower", lo), ("upper", hi), *rates))
+        if attrs:
+            lines.append(f"    <limit {attrs}/>")
         if model.damping[k] or model.coulomb[k]:
             lines.append(f'    <dynamics damping="{_num(model.damping[k])}" friction="{_num(model.coulomb[k])}"/>')
         lines.append("  </joint>")
