@@ -150,7 +150,7 @@ def test_sampled_reference_interpolates(tmp_path):
     np.testing.assert_array_equal(ref(2.0)[0], q[-1])
     path = tmp_path / "ref.csv"
     np.savetxt(path, np.column_stack([t, q]), delimiter=",", header="t,q:joint1,q:joint2", comments="")
-    from_file = control.Sampled.from_csv(rd.models.load("double_pendulum"), path)
+    from_file = control.Sampled.from_csv(path, rd.models.load("double_pendulum"))
     np.testing.assert_allclose(from_file(0.5)[0], ref(0.5)[0], rtol=0, atol=1e-15)
 
 

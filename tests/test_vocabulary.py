@@ -248,3 +248,24 @@ def test_old_symbolic_names_with_a_warning():
                                   R_tree=sm.X_tree_R, p_tree=sm.X_tree_p, inertia=sm.theta, gravity=sm.gravity)
     assert rebuilt.X_tree_p == sm.X_tree_p and rebuilt.theta == sm.theta
     assert all(isinstance(x, sp.Symbol) for x in eom.v + eom.a)
+
+
+def test_a_link_is_a_body_and_readers_take_the_path_first(tmp_path):
+    """``frame`` names the frame vectors are expressed in; the link or frame a function is
+    about is ``body`` (as in ``jacobian``), and every reader takes ``(path, model)``."""
+    model = rd.models.load("panda")
+    x_d = [0.3, 0.0, 0.5]
+    new = control.TaskSpacePD(model, "link7", x_d, kp=10.0, kd=2.0)
+    with pytest.warns(RobodynDeprecationWarning, match="'frame' is deprecated, use 'body'"):
+        old = control.TaskSpacePD(model, frame="link7", x_desired=x_d, kp=10.0, kd=2.0)
+    q, v = np.full(7, 0.2), np.full(7, 0.1)
+    np.testing.assert_array_equal(old(0.0, q, v), new(0.0, q, v))
+    with pytest.warns(RobodynDeprecationWarning):
+        assert old.frame == new.body == "link7"
+    with pytest.raises(TypeError, match=r"missing arguments \['kd'\]"):
+        control.TaskSpacePD(model, "link7", x_d, kp=10.0)
+    path = write_log(tmp_path / "ref.csv", model, [0.0, 0.5, 1.0], np.zeros((3, 7)) + [[0.0], [0.1], [0.2]])
+    ref = control.Sampled.from_csv(path, model)
+    with pytest.warns(RobodynDeprecationWarning, match=r"Sampled.from_csv\(path, model\)"):
+        old_ref = control.Sampled.from_csv(model, path)
+    np.testing.assert_array_equal(old_ref(0.25)[0], ref(0.25)[0])

@@ -211,7 +211,7 @@ def cmd_simulate(args) -> int:
         if model.nq != model.nv:
             raise ValueError("--controller computed-torque needs a fixed-base model")
         if args.reference:
-            reference = control.Sampled.from_csv(model, args.reference)
+            reference = control.Sampled.from_csv(args.reference, model)
         else:
             reference = control.quintic(q0, target, args.duration / 2)
         controller = control.ComputedTorque(model, reference, w * w, 2.0 * w)

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._deprecated import renamed_keywords
+from .._deprecated import renamed_attribute, renamed_keyword, renamed_keywords
 from .. import joints as J
 from ..algorithms.status import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
@@ -258,18 +258,26 @@ class ComputedTorque(Tracking):
 
 
 class TaskSpacePD(Controller):
-    """PD control of the position of a link/frame ``frame`` to ``x_desired`` (world, (3,)),
+    """PD control of the position of a link or frame ``body`` to ``x_desired`` (world, (3,)),
     with gravity compensation and joint damping ``D`` (for the redundant directions):
-    ``tau = J^T (Kp (x_d - x) - Kd J qd) - D qd + g(q)``, ``J`` the (3, nv) linear Jacobian
-    of the frame origin in world axes. ``V = qd^T M qd / 2 + ex^T Kp ex / 2`` has
-    ``dV/dt = -(J qd)^T Kd (J qd) - qd^T D qd``. Siciliano et al. (2009), section 8.6.1."""
+    ``tau = J^T (Kp (x_d - x) - Kd J v) - D v + g(q)``, ``J`` the (3, nv) linear Jacobian
+    of the body's origin in world axes. ``V = v^T M v / 2 + ex^T Kp ex / 2`` has
+    ``dV/dt = -(J v)^T Kd (J v) - v^T D v``. Siciliano et al. (2009), section 8.6.1."""
 
-    def __init__(self, model, frame: str, x_desired, kp, kd, joint_damping=1.0):
+    frame = renamed_attribute("frame", "body")
+
+    def __init__(self, model, body: str | None = None, x_desired=None, kp=None, kd=None, joint_damping=1.0, *,
+                 frame=None):
+        if frame is not None:  # the old spelling of ``body`` (``frame`` is the frame vectors are expressed in)
+            body = renamed_keyword("frame", frame, "body", body, "TaskSpacePD()", default=None)
+        missing = [k for k, x in (("body", body), ("x_desired", x_desired), ("kp", kp), ("kd", kd)) if x is None]
+        if missing:
+            raise TypeError(f"TaskSpacePD() missing arguments {missing}")
         super().__init__(model)
-        b, self._R, self._p = model.frame_index(frame)
+        b, self._R, self._p = model.frame_index(body)
         if b < 0:
-            raise ValueError(f"frame {frame!r} is fixed to the world; it cannot be moved")
-        self.frame, self._body = frame, b
+            raise ValueError(f"frame {body!r} is fixed to the world; it cannot be moved")
+        self.body, self._body = body, b
         self.x_d = np.array(x_desired, dtype=float)
         if self.x_d.shape != (3,) or not np.all(np.isfinite(self.x_d)):
             raise ValueError(f"x_desired: expected 3 finite numbers, got shape {self.x_d.shape}")
@@ -277,8 +285,8 @@ class TaskSpacePD(Controller):
         self.damping = gain("joint_damping", joint_damping, model.nv)
 
     def position_and_jacobian(self, q):
-        """World position (3,) of the frame origin and its linear Jacobian (3, nv) in world
-        axes (the rows ``[:3]`` of ``jacobian(model, q, frame, "local_world_aligned")``)."""
+        """World position (3,) of the body's origin and its linear Jacobian (3, nv) in world
+        axes (the rows ``[:3]`` of ``jacobian(model, q, body, "local_world_aligned")``)."""
         k = self.model.kernel
         q = np.ascontiguousarray(q, dtype=float)
         J, R, p = np.empty((6, self.model.nv)), np.empty((3, 3)), np.empty(3)

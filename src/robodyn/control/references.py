@@ -18,6 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._deprecated import warn_renamed
+
 # Coefficients of s(tau), lowest power first.
 _POLYNOMIALS = {"cubic": (0.0, 0.0, 3.0, -2.0), "quintic": (0.0, 0.0, 0.0, 10.0, -15.0, 6.0)}
 _SCALINGS = {
@@ -127,10 +129,14 @@ class Sampled:
         return np.ascontiguousarray(self.spline.x), np.ascontiguousarray(self.spline.c)
 
     @classmethod
-    def from_csv(cls, model, path) -> "Sampled":
-        """The ``q`` columns of a trajectory or log file (format of :mod:`robodyn.io.log`)."""
+    def from_csv(cls, path, model) -> "Sampled":
+        """The ``q`` columns of a trajectory or log file (format of :mod:`robodyn.io.log`);
+        ``(path, model)`` as every reader of robodyn (the old order ``(model, path)`` warns)."""
         from ..io.log import read_log
+        from ..model import Model
 
+        if isinstance(path, Model):
+            warn_renamed("Sampled.from_csv(model, path)", "Sampled.from_csv(path, model)", "robodyn")
+            path, model = model, path
         log = read_log(path, model)
-        t, q = log.t, log.q
-        return cls(t, q)
+        return cls(log.t, log.q)
