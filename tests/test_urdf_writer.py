@@ -29,13 +29,14 @@ def _permutations(model, other):
 
 @pytest.mark.parametrize("name", rd.models.names())
 def test_builtin_round_trip(name):
-    model = rd.models.load(name).replace(armature=np.zeros(rd.models.load(name).nv))
+    """Everything comes back, the armature too (as Drake's rotor inertia)."""
+    model = rd.models.load(name)
     back = _reload(model)
     assert back.joint_names == model.joint_names and back.link_names == model.link_names
     q, v, a = states(model, "urdf", size=3)
     assert_rel(rd.rnea(back, q, v, a), rd.rnea(model, q, v, a), 1e-12)
     assert_rel(back.inertial_parameters(), model.inertial_parameters(), 1e-12)
-    for key in ("lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb"):
+    for key in ("lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature"):
         assert np.array_equal(getattr(back, key), getattr(model, key)), key
     assert sorted(back.frame_names) == sorted(model.frame_names)
     for f in model.frame_names:
@@ -81,8 +82,12 @@ def test_written_file_and_unbounded_joints(tmp_path):
 
 def test_what_urdf_cannot_hold():
     model = rd.models.load("puma560")  # has armature
-    with pytest.warns(rd.RobodynWarning, match="armature"):
-        rd.write_urdf(model)
+    slider = rd.ModelBuilder()
+    slider.add_link("root")
+    slider.add_link("a", mass=1.0, inertia=0.01 * np.eye(3))
+    slider.add_joint("j", "planar", "root", "a", armature=0.1)
+    with pytest.warns(rd.RobodynWarning, match="armature of multi-dof joints"):
+        rd.write_urdf(slider.build())
     with pytest.warns(rd.RobodynWarning, match="gravity"):
         rd.write_urdf(model.replace(armature=np.zeros(6), gravity=(0, -9.81, 0)))
     lower = np.array(model.lower)
@@ -160,16 +165,64 @@ def _pinocchio_reads(model):
 def test_pinocchio_reads_what_it_writes(model):
     """Another library reads the written file to the same dynamics: Pinocchio's rnea and mass
     matrix of ``write_urdf(model)`` equal robodyn's of the model (friction and armature, which
-    Pinocchio's rnea leaves out, off)."""
+    Pinocchio's rnea leaves out, off; the armature is in Drake's extension, which Pinocchio
+    skips)."""
     import pinocchio as pin
 
-    model = model.replace(armature=np.zeros(model.nv))
     pm, to_pin, pv = _pinocchio_reads(model)
     data = pm.createData()
     q, v, a = states(model, "pin-writer", size=3)
-    expected = rd.rnea(model, q, v, a, friction=False)
-    M = rd.crba(model, q)
+    expected = rd.rnea(model, q, v, a, friction=False, armature=False)
+    M = rd.crba(model, q, armature=False)
     for k in range(3):
         assert_rel(pin.rnea(pm, data, to_pin(q[k]), v[k, pv], a[k, pv]), expected[k, pv], 1e-10, f"rnea {k}")
         Mp = pin.crba(pm, data, to_pin(q[k]))
         assert_rel(np.triu(Mp) + np.triu(Mp, 1).T, M[k][np.ix_(pv, pv)], 1e-10, f"crba {k}")
+
+
+def test_drake_rotor_inertia(tmp_path):
+    """Drake's armature extension, as Drake writes it (gear ratio, a prefix declared or not),
+    and its errors."""
+    arm = """<robot name="r"{decl}><link name="a"/><link name="b"><inertial><mass value="1"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial></link>
+    <joint name="j" type="continuous"><parent link="a"/><child link="b"/><axis xyz="0 0 1"/></joint>
+    <transmission name="t"><type>SimpleTransmission</type><joint name="{joint}"/>
+    <actuator name="m"><drake:rotor_inertia value="0.002"/><drake:gear_ratio value="10"/></actuator>
+    </transmission></robot>"""
+    for decl in (' xmlns:drake="http://drake.mit.edu"', ""):
+        model = rd.load_urdf(arm.format(decl=decl, joint="j"))
+        assert model.armature.tolist() == [pytest.approx(0.2)]  # 0.002 * 10^2
+        assert_rel(rd.crba(model, np.zeros(1)), np.array([[0.2 + 0.1]]), 1e-15)
+    with pytest.raises(rd.ModelError, match=r"drake:rotor_inertia of joints that do not exist: \['k'\]"):
+        rd.load_urdf(arm.format(decl="", joint="k"))
+    with pytest.raises(rd.ModelError, match="armature"):
+        rd.load_urdf(arm.format(decl="", joint="j").replace('value="0.002"', 'value="-1"'))
+
+
+def test_every_example_robot_written_loads_in_pinocchio():
+    """Every example-robot-data URDF robodyn loads, written back: Pinocchio reads the file to
+    robodyn's dynamics (rnea and the mass matrix at a random state, fixed base)."""
+    import warnings
+
+    import pinocchio as pin
+    from conftest import example_robot_urdfs
+
+    checked = 0
+    for path in example_robot_urdfs():
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rd.RobodynWarning)
+            try:
+                model = rd.load_urdf(path)
+            except rd.ModelError:
+                continue  # refused files are checked in test_urdf.py
+            if model.nv == 0:
+                continue
+            pm, to_pin, pv = _pinocchio_reads(model)
+        data = pm.createData()
+        q, v, a = (x[0] for x in states(model, "erd-writer", size=1))
+        assert_rel(pin.rnea(pm, data, to_pin(q), v[pv], a[pv]), rd.rnea(model, q, v, a, friction=False,
+                   armature=False)[pv], 1e-9, str(path))
+        Mp = pin.crba(pm, data, to_pin(q))
+        assert_rel(np.triu(Mp) + np.triu(Mp, 1).T, rd.crba(model, q, armature=False)[np.ix_(pv, pv)], 1e-9, str(path))
+        checked += 1
+    assert checked >= 50, checked

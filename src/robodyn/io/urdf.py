@@ -7,7 +7,9 @@ joint; its parent link must be the root or welded to it) and planar (with ``<axi
 ``<axis>`` (normalised; zero is an error), ``<limit lower upper velocity effort>`` (lower and
 upper default to 0 as in the URDF specification; +-1.7976931348623157e+308, the largest
 double, is no limit, as ``write_urdf`` writes it; a joint without ``<limit>`` is unbounded,
-continuous joints always are), ``<dynamics damping friction>``.
+continuous joints always are), ``<dynamics damping friction>``, and a joint's armature from
+Drake's ``<transmission>`` extension (an ``<actuator>`` with ``<drake:rotor_inertia value>``
+and ``<drake:gear_ratio value>``: ``rotor_inertia * gear_ratio^2``; ``write_urdf`` writes it).
 ``<mimic>`` joints load as independent joints with a warning. Elements without rigid-body
 dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
 reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
@@ -53,6 +55,34 @@ NO_LIMIT = float(np.finfo(float).max)  # "no limit" in a file (URDF has no infin
 def _no_limit(x: float) -> float:
     """A limit of +-the largest double is no limit (+-inf)."""
     return math.copysign(math.inf, x) if abs(x) >= NO_LIMIT else x
+
+
+DRAKE = ("http://drake.mit.edu", "urn:undeclared:drake")  # Drake's extension namespace, declared or not
+
+
+def _drake(elem, name: str):
+    """The first child ``<drake:name>`` of ``elem``, or None."""
+    return next((c for c in elem if c.tag in {f"{{{uri}}}{name}" for uri in DRAKE}), None)
+
+
+def _read_transmission(rd: "_Reader", elem) -> dict[str, float]:
+    """``{joint: armature}`` of a ``<transmission>`` whose actuator has Drake's
+    ``<drake:rotor_inertia value>`` (and ``<drake:gear_ratio value>``, default 1): the rotor
+    inertia reflected on the joint, ``rotor_inertia * gear_ratio^2``. Empty for the other
+    transmissions (no rigid-body dynamics)."""
+    out = {}
+    for act in (c for c in elem if c.tag == "actuator"):
+        rotor = _drake(act, "rotor_inertia")
+        if rotor is None:
+            continue
+        joints = [j.get("name") for j in elem if j.tag == "joint"]
+        if len(joints) != 1 or not joints[0]:
+            raise ModelError(f"{rd.where(elem)}: a transmission with drake:rotor_inertia needs one named <joint>, "
+                             f"got {joints}")
+        ratio = _drake(act, "gear_ratio")
+        gear = rd.floats(ratio, "value", 1)[0] if ratio is not None else 1.0
+        out[joints[0]] = out.get(joints[0], 0.0) + rd.floats(rotor, "value", 1)[0] * gear * gear
+    return out
 
 
 def _child(elem, tag: str):
@@ -122,7 +152,7 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     b = ModelBuilder(root.get("name", "robot"), gravity=gravity, source=name, physical=physical)
     ignored: Counter[str] = Counter()
     mimic, reversed_limits = [], []
-    joint_elems = []
+    joint_elems, armature = [], {}
     for elem in root:
         if not isinstance(elem.tag, str):
             continue
@@ -130,14 +160,20 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
             _read_link(rd, b, elem, ignored)
         elif elem.tag == "joint":
             joint_elems.append(elem)
+        elif elem.tag == "transmission" and (rotors := _read_transmission(rd, elem)):
+            for joint, value in rotors.items():
+                armature[joint] = armature.get(joint, 0.0) + value
         else:
             ignored[elem.tag] += 1
+    unknown = sorted(set(armature) - {str(e.get("name")) for e in joint_elems})
+    if unknown:
+        raise ModelError(f"{name}: drake:rotor_inertia of joints that do not exist: {unknown}")
     if _child(root, "link") is None:
         raise ModelError(f"{rd.where(root)}: no <link> element")
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
         if _child(elem, "mimic") is not None:
             mimic.append(elem.get("name"))
-        _read_joint(rd, b, elem, ignored, reversed_limits)
+        _read_joint(rd, b, elem, ignored, reversed_limits, armature.get(str(elem.get("name")), 0.0))
     if reversed_limits:
         warnings.warn(
             f"{name}: joint limits with lower > upper loaded as unbounded: {', '.join(reversed_limits)}",
@@ -230,7 +266,8 @@ def read_collisions(source) -> list[Collision]:
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 
 
-def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list) -> None:
+def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list,
+                armature: float = 0.0) -> None:
     where = rd.where(elem)
     for child in elem:
         if isinstance(child.tag, str) and child.tag not in _JOINT_READ:
@@ -269,4 +306,6 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
         for key in ("damping", "friction"):
             if dyn.get(key) is not None:
                 kw[key] = rd.floats(dyn, key, 1)[0]
+    if armature:
+        kw["armature"] = armature
     b.add_joint(jname, jtype, parent, child, xyz=xyz, rpy=rpy, axis=axis, where=where, **kw)

@@ -15,9 +15,12 @@ beside a fixed base) become ``floating`` joints under the root link. Spherical j
 joints beside a floating base, raise ``ValueError``. Numbers are written with ``repr``
 (exact round trip).
 
-What URDF cannot hold is reported with a :class:`RobodynWarning`: armature, Coulomb
-smoothing, and a gravity other than ``(0, 0, -9.81)`` (``load_urdf(gravity=...)`` sets it). A
-one-sided position limit raises ``ValueError``.
+A 1-dof joint's armature is written as Drake's extension, a ``<transmission>`` whose actuator
+has ``<drake:rotor_inertia value>`` (gear ratio 1): Drake reads it as the reflected rotor
+inertia, ``load_urdf`` as the armature, and other readers (urdfdom, Pinocchio, ROS) ignore
+it. What URDF cannot hold is reported with a :class:`RobodynWarning`: the armature of
+multi-dof joints, Coulomb smoothing, and a gravity other than ``(0, 0, -9.81)``
+(``load_urdf(gravity=...)`` sets it). A one-sided position limit raises ``ValueError``.
 """
 
 from __future__ import annotations
@@ -75,6 +78,7 @@ def _link_and_joint(model, i: int, kind: str, parent: str) -> list[str]:
             f"    {_origin(model.X_tree_R[i], model.X_tree_p[i])}"]
 
 
+DRAKE = "http://drake.mit.edu"  # the namespace of Drake's URDF extensions
 NO_LIMIT = float(np.finfo(float).max)  # URDF has no infinity: the largest double means "no limit"
 
 
@@ -86,14 +90,19 @@ def _finite(x: float) -> float:
 def write_urdf(model, path=None) -> str:
     """The URDF text of ``model`` (module docstring); also written to ``path`` if given."""
     lost = []
-    if np.any(model.armature != 0):
-        lost.append("armature")
+    one_dof = J.NV[model.joint_type] == 1
+    rotors = [(model.body_joint_names[i], model.armature[model.idx_v[i]]) for i in range(model.nbodies)
+              if one_dof[i] and model.armature[model.idx_v[i]] != 0]
+    if any(np.any(model.armature[model.idx_v[i]:model.idx_v[i] + J.NV[model.joint_type[i]]] != 0)
+           for i in range(model.nbodies) if not one_dof[i]):
+        lost.append("armature of multi-dof joints")
     if model.coulomb_smoothing != 0:
         lost.append("coulomb_smoothing")
     if np.any(model.gravity != np.array([0.0, 0.0, -9.81])):
         lost.append(f"gravity {model.gravity.tolist()} (pass it to load_urdf)")
     taken = set(model.link_names) | set(model.frame_names)
-    lines = ["<?xml version=\"1.0\"?>", f"<robot name={quoteattr(model.name)}>"]
+    drake = f' xmlns:drake="{DRAKE}"' if rotors else ""
+    lines = ["<?xml version=\"1.0\"?>", f"<robot name={quoteattr(model.name)}{drake}>"]
     floating = model.floating_base
     world = [k for k in range(len(model.frame_names)) if model.frame_body[k] == -1]
     if floating:
@@ -161,6 +170,14 @@ def write_urdf(model, path=None) -> str:
                   f"    <child link={quoteattr(name)}/>",
                   f"    {_origin(model.frame_R[f], model.frame_p[f])}",
                   "  </joint>"]
+    for joint, inertia in rotors:  # armature as Drake's rotor inertia (other readers ignore it)
+        lines += [f"  <transmission name={quoteattr(joint + '_transmission')}>",
+                  "    <type>transmission_interface/SimpleTransmission</type>",
+                  f"    <joint name={quoteattr(joint)}>"
+                  "<hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>",
+                  f"    <actuator name={quoteattr(joint + '_motor')}><drake:rotor_inertia value=\"{_num(inertia)}\"/>"
+                  "</actuator>",
+                  "  </transmission>"]
     lines.append("</robot>")
     text = "\n".join(lines) + "\n"
     if lost:
