@@ -36,7 +36,7 @@ _LAZY = {
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
               "rollout": "simulation", "Rollouts": "simulation", "simulation": None,
               "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
-              "contact": None, "Contacts": "contact"}
+              "contact": None, "Contacts": "contact", "inertia": None}
 
 
 def __getattr__(name):

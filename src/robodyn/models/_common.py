@@ -1,25 +1,11 @@
-"""Helpers shared by the built-in robots: inertias of uniform bodies and extra frames."""
+"""Helpers shared by the built-in robots: inertias from their upper triangle and extra frames
+(the inertias of uniform bodies are in :mod:`robodyn.inertia`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from ..model import Model
-
-
-def axisymmetric_inertia(axial: float, transverse: float, axis: str) -> np.ndarray:
-    """Diagonal 3 x 3 inertia: ``axial`` about the frame axis ``axis`` (``"x"``, ``"y"`` or
-    ``"z"``), ``transverse`` about the two others."""
-    moments = np.full(3, float(transverse))
-    moments["xyz".index(axis)] = axial
-    return np.diag(moments)
-
-
-def cylinder_inertia(mass: float, radius: float, length: float, axis: str) -> np.ndarray:
-    """3 x 3 inertia about the centre of a uniform solid cylinder whose axis is ``axis``:
-    ``m r^2 / 2`` about the axis and ``m (3 r^2 + l^2) / 12`` about the two others.
-    ``radius = 0`` is a thin rod."""
-    return axisymmetric_inertia(mass * radius**2 / 2.0, mass * (3.0 * radius**2 + length**2) / 12.0, axis)
 
 
 def inertia_from_upper(ixx: float, ixy: float, ixz: float, iyy: float, iyz: float, izz: float) -> np.ndarray:

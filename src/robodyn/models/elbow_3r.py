@@ -30,7 +30,7 @@ import numpy as np
 
 from ..io.dh import DHLink, from_dh
 from ..model import Model
-from ._common import cylinder_inertia
+from ..inertia import cylinder
 
 D1, A2, A3 = 0.4, 0.4, 0.35
 MASSES = (5.0, 4.0, 2.0)
@@ -42,11 +42,11 @@ def links() -> list[DHLink]:
     (m1, m2, m3), (r1, r2, r3) = MASSES, RADII
     return [
         DHLink(a=0.0, alpha=np.pi / 2, d=D1, mass=m1, com=(0.0, -D1 / 2, 0.0),
-               inertia=cylinder_inertia(m1, r1, D1, "y")),
+               inertia=cylinder(m1, r1, D1, "y")),
         DHLink(a=A2, alpha=0.0, d=0.0, mass=m2, com=(-A2 / 2, 0.0, 0.0),
-               inertia=cylinder_inertia(m2, r2, A2, "x")),
+               inertia=cylinder(m2, r2, A2, "x")),
         DHLink(a=A3, alpha=0.0, d=0.0, mass=m3, com=(-A3 / 2, 0.0, 0.0),
-               inertia=cylinder_inertia(m3, r3, A3, "x")),
+               inertia=cylinder(m3, r3, A3, "x")),
     ]
 
 

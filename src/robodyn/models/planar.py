@@ -51,7 +51,8 @@ import numpy as np
 
 from ..io.dh import DHLink, from_dh
 from ..model import Model
-from ._common import cylinder_inertia, homogeneous
+from ..inertia import cylinder
+from ._common import homogeneous
 
 # Base frame 0 of the pendulums in the world: x0 = world z (up), y0 = world x, z0 = world y.
 PENDULUM_BASE = homogeneous(np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]))
@@ -91,5 +92,5 @@ def planar_2r() -> Model:
     lengths, masses = [p["l1"], p["l2"]], [p["m1"], p["m2"]]
     # DH frame i sits at the distal end of rod i, x_i along the rod: the centre is at -l_i/2.
     coms = [(-l / 2.0, 0.0, 0.0) for l in lengths]
-    inertias = [cylinder_inertia(m, 0.0, l, "x") for m, l in zip(masses, lengths)]
+    inertias = [cylinder(m, 0.0, l, "x") for m, l in zip(masses, lengths)]
     return _chain("planar_2r", lengths, masses, coms, inertias, PLANAR_2R_BASE)

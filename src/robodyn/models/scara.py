@@ -31,7 +31,7 @@ import numpy as np
 
 from ..io.dh import DHLink, from_dh
 from ..model import Model
-from ._common import cylinder_inertia
+from ..inertia import cylinder
 
 D1, A1, A2 = 0.4, 0.325, 0.275
 STROKE = 0.21
@@ -45,13 +45,13 @@ def links() -> list[DHLink]:
     deg = np.pi / 180.0
     return [
         DHLink(a=A1, alpha=0.0, d=D1, mass=m1, com=(-A1 / 2, 0.0, 0.0),
-               inertia=cylinder_inertia(m1, 0.05, A1, "x"), lower=-105 * deg, upper=105 * deg),
+               inertia=cylinder(m1, 0.05, A1, "x"), lower=-105 * deg, upper=105 * deg),
         DHLink(a=A2, alpha=np.pi, d=0.0, mass=m2, com=(-A2 / 2, 0.0, 0.0),
-               inertia=cylinder_inertia(m2, 0.04, A2, "x"), lower=-150 * deg, upper=150 * deg),
+               inertia=cylinder(m2, 0.04, A2, "x"), lower=-150 * deg, upper=150 * deg),
         DHLink(a=0.0, alpha=0.0, d=0.0, theta=0.0, joint="prismatic", mass=m3,
-               com=(0.0, 0.0, -QUILL_LENGTH / 2), inertia=cylinder_inertia(m3, 0.01, QUILL_LENGTH, "z"),
+               com=(0.0, 0.0, -QUILL_LENGTH / 2), inertia=cylinder(m3, 0.01, QUILL_LENGTH, "z"),
                lower=0.0, upper=STROKE),
-        DHLink(a=0.0, alpha=0.0, d=0.0, mass=m4, inertia=cylinder_inertia(m4, 0.04, 0.02, "z"),
+        DHLink(a=0.0, alpha=0.0, d=0.0, mass=m4, inertia=cylinder(m4, 0.04, 0.02, "z"),
                lower=-360 * deg, upper=360 * deg),
     ]
 

@@ -39,7 +39,7 @@ import numpy as np
 
 from ..io.dh import DHLink, from_dh
 from ..model import Model
-from ._common import axisymmetric_inertia
+from ..inertia import axisymmetric
 
 # a, d, alpha
 DH = [
@@ -76,7 +76,7 @@ TORQUE = (150.0, 150.0, 150.0, 28.0, 28.0, 28.0)
 def links() -> list[DHLink]:
     """The DH table with UR's masses and centres of mass and ROS's inertias (module doc)."""
     return [
-        DHLink(a=a, alpha=alpha, d=d, mass=m, com=c, inertia=axisymmetric_inertia(*cyl),
+        DHLink(a=a, alpha=alpha, d=d, mass=m, com=c, inertia=axisymmetric(*cyl),
                lower=-lim, upper=lim, velocity=VELOCITY, effort=t)
         for (a, d, alpha), m, c, cyl, lim, t in zip(DH, MASS, COM, CYLINDER, POSITION_LIMIT, TORQUE)
     ]
