@@ -335,3 +335,31 @@ def test_long_chain_and_long_cycle():
         b.add_joint(f"k{i}", "fixed", f"c{i}", f"c{(i + 1) % n}")
     with pytest.raises(rd.ModelError, match="cycle through links"):
         b.build()
+
+
+def test_the_world_is_implicit():
+    """A joint whose parent is "world" needs no add_link("world"): the root is the fixed,
+    massless world, and the model equals the one with the root link added by hand."""
+    def build(explicit):
+        b = rd.ModelBuilder("arm")
+        if explicit:
+            b.add_link("world")
+        b.add_link("link1", mass=1.0, com=(0.5, 0, 0), inertia=np.diag([0.01, 0.1, 0.1]))
+        b.add_joint("j1", "revolute", "world", "link1", axis=(0, 0, 1))
+        return b.build()
+
+    implicit, explicit = build(False), build(True)
+    assert implicit.frame_names == explicit.frame_names == ("world",)
+    q = np.array([0.4])
+    np.testing.assert_array_equal(rd.crba(implicit, q), rd.crba(explicit, q))
+    b = rd.ModelBuilder("two roots")
+    b.add_link("base")
+    b.add_link("link1", mass=1.0, inertia=np.eye(3) * 0.1)
+    b.add_joint("j1", "revolute", "world", "link1")
+    with pytest.raises(rd.ModelError, match=r"several root links \['base', 'world'\]"):
+        b.build()
+    b = rd.ModelBuilder("typo")
+    b.add_link("link1", mass=1.0, inertia=np.eye(3) * 0.1)
+    b.add_joint("j1", "revolute", "wrold", "link1")
+    with pytest.raises(rd.ModelError, match="parent link 'wrold' does not exist"):
+        b.build()

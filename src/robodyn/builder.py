@@ -13,12 +13,17 @@ the world. A body that fails names every link merged into it and what each one c
 are checked alone only for what no merge can repair: non-finite values, an asymmetric inertia,
 a negative mass.
 
+Links are added with :meth:`ModelBuilder.add_link` (mass, centre of mass, 3 x 3 inertia about
+it: see :mod:`robodyn.inertia`), joints with :meth:`ModelBuilder.add_joint` (types
+``revolute``, ``continuous``, ``prismatic``, ``helical``, ``fixed``, ``planar``,
+``spherical``, ``free`` and ``universal``). The root is the one link without a parent; a
+joint whose parent is ``"world"`` attaches to the world without an ``add_link("world")``.
+
 Example::
 
     b = ModelBuilder("arm")
-    b.add_link("base")
     b.add_link("link1", mass=1.0, com=(0.5, 0, 0), inertia=np.diag([0, 0.1, 0.1]))
-    b.add_joint("j1", "revolute", "base", "link1", axis=(0, 0, 1))
+    b.add_joint("j1", "revolute", "world", "link1", axis=(0, 0, 1))
     model = b.build()
 """
 
@@ -34,6 +39,7 @@ from .errors import RobodynWarning
 from .model import (Model, ModelError, check_inertial_parameters, consistent_inertial_parameters,
                     inertial_parameters_from, inertial_parameters_in_parent)
 
+WORLD = "world"  # a joint's parent link of this name needs no add_link: the fixed root
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
                "spherical": J.SPHERICAL, "helical": J.HELICAL, "planar": J.PLANAR, "fixed": None}
 
@@ -221,7 +227,10 @@ class ModelBuilder:
 
     # ---------------------------------------------------------------------------------
     def _check_graph(self) -> tuple[str, dict[str, list[_Joint]]]:
-        """Return the root link and the child joints of each link, or raise ModelError."""
+        """Return the root link and the child joints of each link, or raise ModelError. A
+        parent link ``"world"`` that was not added is the implicit, massless root."""
+        if WORLD not in self._links and any(jt.parent == WORLD for jt in self._joints):
+            self._links[WORLD] = _Link(WORLD, np.zeros(10), f"{self.source}: link 'world' (implicit: the root)")
         if not self._links:
             raise ModelError(f"{self.source}: no links")
         seen_joint: dict[str, _Joint] = {}
