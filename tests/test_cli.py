@@ -183,3 +183,32 @@ def test_warmup_compiles_every_step_and_draws_a_bar_on_a_terminal(capsys, monkey
     code, out, err = run(capsys, "warmup")
     assert code == 0 and "2 steps" in out
     assert "[" + "#" * 30 + "] 100%" in err
+
+
+def test_demo_says_when_rnea_adds_friction_and_armature(capsys):
+    """The slides' recipe "rnea gives M a + C v + g" holds for the rigid bodies only: on a
+    robot with joint friction and rotor inertia (PUMA 560) the demo prints what rnea's
+    defaults add, and the numbers it prints are those of rnea and of model.rigid()."""
+    code, out, _ = run(capsys, "demo", "puma560")
+    assert code == 0 and "NOTE rnea(model, q, v, a) with its defaults also adds" in out
+    model = rd.models.load("puma560")
+    q, v, a = sample_state(model, 0)
+    full = rd.rnea(model, q, v, a)
+    rigid = rd.rnea(model.rigid(), q, v, a)
+    np.testing.assert_array_equal(rigid, rd.rnea(model, q, v, a, friction=False, armature=False))
+    more = float(re.search(r"up to ([0-9.e+-]+) N m more", out).group(1))
+    assert more == pytest.approx(np.abs(full - rigid).max(), rel=1e-3) and more > 1.0
+    code, out, _ = run(capsys, "demo", "planar_2r")
+    assert "no joint friction or armature in this model" in out
+
+
+def test_a_free_simulation_moves(capsys):
+    """Without a controller the run starts away from the default pose (an equilibrium of the
+    pendulum), so something moves; energy is conserved."""
+    code, out, _ = run(capsys, "simulate", "pendulum", "--duration", "0.5")
+    assert code == 0
+    start, end, drift = (float(x) for x in re.search(r"energy: start (\S+) J, end (\S+) J, max \|E - E0\| (\S+) J",
+                                                      out).groups())
+    model = rd.models.load("pendulum")
+    assert start == pytest.approx(float(rd.potential_energy(model, np.array([0.5]))), rel=1e-5)
+    assert drift < 1e-8 * abs(start)

@@ -324,3 +324,13 @@ def test_vectorised_inertia_check_agrees_with_the_scalar_one():
             scalar = False
         assert ok == scalar, theta
     assert 50 < mask.sum() < 350  # both kinds occur
+
+
+def test_rigid_strips_friction_and_armature():
+    model = rd.models.load("puma560")
+    assert np.any(model.damping) and np.any(model.armature)
+    rigid = model.rigid()
+    assert not (np.any(rigid.damping) or np.any(rigid.coulomb) or np.any(rigid.armature))
+    np.testing.assert_array_equal(rigid.theta, model.theta)
+    q, v, a = np.full(6, 0.3), np.full(6, -0.5), np.full(6, 0.2)
+    np.testing.assert_array_equal(rd.rnea(rigid, q, v, a), rd.rnea(model, q, v, a, friction=False, armature=False))

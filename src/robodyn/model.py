@@ -380,6 +380,13 @@ class Model:
 
     inertia = renamed_attribute("inertia", "theta")  # ``inertia`` names 3 x 3 matrices in robodyn
 
+    def rigid(self) -> "Model":
+        """The model without joint friction and armature (``damping``, ``coulomb`` and
+        ``armature`` zero): its ``rnea`` is the textbook ``M(q) a + C(q, v) v + g(q)`` of the
+        rigid bodies alone, as ``rnea(..., friction=False, armature=False)`` of this model."""
+        zero = np.zeros(self.nv)
+        return self.replace(damping=zero, coulomb=zero, armature=zero)
+
     def replace(self, **changes) -> "Model":
         """A new model with some constructor arguments changed (validated again)."""
         if "inertia" in changes:  # the old spelling of ``theta``

@@ -63,26 +63,34 @@ def cmd_demo(args) -> int:
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
     print(f"robodyn demo on {model.name!r}: nq={model.nq}, nv={model.nv}, {model.nbodies} bodies, "
           f"mass {model.total_mass:.3f} kg")
-    print(f"  q   = {q}\n  qd  = {v}\n  qdd = {a}")
+    print(f"  q   = {q}\n  v   = {v}\n  a   = {a}")
 
     M = rd.crba(model, q, armature=False)
     inertial = M @ a
     coriolis = rd.coriolis_matrix(model, q, v) @ v
     grav = rd.gravity(model, q)
     tau = rd.rnea(model, q, v, a, friction=False, armature=False)
-    print("\nInverse dynamics (RNEA): tau = M(q) qdd + C(q, qd) qd + g(q)   [N m or N]")
+    print("\nInverse dynamics (RNEA): tau = M(q) a + C(q, v) v + g(q)   [N m or N]")
     print(f"  {'joint':<22} {'inertial':>10} {'coriolis':>10} {'gravity':>10} {'total':>10}")
     names = model.dof_names
     for k in range(model.nv):
         print(f"  {names[k]:<22} {inertial[k]:10.4f} {coriolis[k]:10.4f} {grav[k]:10.4f} {tau[k]:10.4f}")
     residual = np.abs(inertial + coriolis + grav - tau).max()
-    print(f"  max |M qdd + C qd + g - rnea| = {residual:.2e}")
+    print(f"  max |M a + C v + g - rnea| = {residual:.2e}")
+    extra = rd.rnea(model, q, v, a) - tau
+    if np.any(model.damping) or np.any(model.coulomb) or np.any(model.armature):
+        print("  NOTE rnea(model, q, v, a) with its defaults also adds the joints' friction and rotor inertia\n"
+              f"  (armature), up to {np.abs(extra).max():.4g} N m more: {rd.rnea(model, q, v, a)};\n"
+              "  friction=False, armature=False (or model.rigid()) give the rigid-body terms above")
+    else:
+        print("  (no joint friction or armature in this model; rnea, aba and crba add them by default\n"
+              "  when a model has them: friction=False, armature=False or model.rigid() leave them out)")
 
-    qdd = rd.aba(model, q, v, tau, friction=False, armature=False)
-    print("\nForward dynamics (ABA) of those torques recovers qdd:")
-    print(f"  qdd = {qdd}\n  max |aba(rnea(qdd)) - qdd| = {np.abs(qdd - a).max():.2e}")
-    qdd0 = rd.aba(model, q, v, np.zeros(model.nv), friction=False, armature=False)
-    print(f"  with tau = 0 (falling under gravity): qdd = {qdd0}")
+    acc = rd.aba(model, q, v, tau, friction=False, armature=False)
+    print("\nForward dynamics (ABA) of those torques recovers a:")
+    print(f"  a = {acc}\n  max |aba(rnea(a)) - a| = {np.abs(acc - a).max():.2e}")
+    acc0 = rd.aba(model, q, v, np.zeros(model.nv), friction=False, armature=False)
+    print(f"  with tau = 0 (falling under gravity): a = {acc0}")
 
     print("\nMass matrix M(q) (CRBA):")
     print(M)

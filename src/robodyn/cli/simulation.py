@@ -7,8 +7,9 @@
     robodyn torques MODEL traj.csv [--plot contributions.png]
 
 ``simulate`` starts at rest at ``--q0`` (default: every joint at 0, or mid-range when 0 is
-outside its limits) and drives the robot to ``--target`` (default: ``q0 + 0.5`` rad or m per
-joint, kept inside the limits): ``pd-gravity`` regulates to the target, ``computed-torque``
+outside its limits; without a controller, 0.5 rad or m from there, since the default pose is
+often an equilibrium where nothing would move) and drives the robot to ``--target`` (default:
+``q0 + 0.5`` rad or m per joint, kept inside the limits): ``pd-gravity`` regulates to the target, ``computed-torque``
 tracks a quintic from ``q0`` to the target in the first half of the run, or the trajectory
 of a CSV file given with ``--reference`` (interpolated by a cubic spline). The gains follow
 from one natural frequency ``--omega`` (PD gains scaled by the diagonal of the mass matrix,
@@ -189,6 +190,8 @@ def cmd_simulate(args) -> int:
 
         q_start = read_trajectory(args.reference, model)[1][0]
     q0, target = start_and_target(model, q_start, _vector(args.target, model.nv, "--target"))
+    if args.controller == "none" and contacts is None and q_start is None and model.nq == model.nv:
+        q0 = target  # a free run starts 0.5 from the default pose (often an equilibrium), so it moves
     if contacts is not None and q_start is None:
         if not (np.isfinite(args.drop) and args.drop >= 0):
             raise ValueError(f"--drop: must be finite and >= 0, got {args.drop}")
