@@ -20,6 +20,7 @@ which is what makes 6- and 7-dof derivations take seconds instead of hours.
 
 from __future__ import annotations
 
+from fractions import Fraction
 from math import comb
 
 import sympy as sp
@@ -217,7 +218,19 @@ class TrigRing(VectorAlgebra):
 
 
 def readable_numbers(e: sp.Expr) -> sp.Expr:
-    """Rationals with denominators above 10^6 (the exact values of decimal model data such as
-    ``1/12 * 10`` written as ``0.8333333333333334``) as floats, for display."""
-    reps = {r: sp.Float(r, 16) for r in e.atoms(sp.Rational) if r.q > 10**6}
+    """``e`` for display: rationals with denominators above 10^6 (the exact values of decimal
+    model data such as ``10 / 6`` stored as ``1.666666666666667``) become the fraction with a
+    denominator up to 1000 they round (``5/3``, ``10``) when there is one within 1e-12,
+    otherwise floats of 15 significant digits (``0.612950000000000``; a lower precision would
+    carry into every evaluation of the expression)."""
+    reps = {}
+    for r in e.atoms(sp.Rational):
+        if r.q <= 10**6:
+            continue
+        x = float(r)
+        near = Fraction(x).limit_denominator(1000)
+        if abs(x - near.numerator / near.denominator) <= 1e-12 * abs(x):
+            reps[r] = sp.Rational(near.numerator, near.denominator)
+        else:
+            reps[r] = sp.Float(x, 15)
     return e.xreplace(reps) if reps else e
