@@ -8,7 +8,7 @@
 """
 
 from .builder import ModelBuilder
-from .io import DHLink, dh_transform, from_dh, load_mjcf, load_urdf, write_mjcf, write_urdf
+from .io import DHLink, dh_transform, from_dh, from_poe, load_mjcf, load_urdf, write_mjcf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
 from . import models, random
@@ -30,7 +30,7 @@ _LAZY = {
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
     "slotine_li_regressor": "regressor", "rnea_derivatives": "rnea_derivatives",
-    "aba_derivatives": "aba_derivatives",
+    "aba_derivatives": "aba_derivatives", "mass_matrix_from_jacobians": "mass_jacobians",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
@@ -67,12 +67,13 @@ def __dir__():
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh",
+    "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh", "from_poe",
     "load_urdf", "load_mjcf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",
     "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
+    "mass_matrix_from_jacobians",
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf", "write_mjcf",

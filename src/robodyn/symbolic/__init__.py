@@ -16,12 +16,12 @@ and ``tau`` from the recursions without the expanded derivation; :func:`regresso
 """
 
 from .equations import EquationsOfMotion, equations_of_motion
-from .model import (SymbolicModel, from_dh, from_model, inertia_symbols, inertial_parameters,
+from .model import (SymbolicModel, from_dh, from_model, from_poe, inertia_symbols, inertial_parameters,
                     with_inertia_symbols)
 from .recursive import RecursiveDynamics, recursive_dynamics
 from .regressor import Regressor, regressor
 
 __all__ = [
-    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "from_dh",
+    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "from_dh", "from_poe",
     "from_model", "inertia_symbols", "inertial_parameters", "recursive_dynamics", "regressor", "with_inertia_symbols",
 ]

@@ -308,3 +308,27 @@ def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Ra
         X_tree_R=tuple(R_tree), X_tree_p=tuple(p_tree), theta=tuple(inertia), gravity=list(gravity),
         armature=tuple(getattr(L, "armature", 0) for L in links), name=name,
     )
+
+
+def from_poe(twists, home, inertias: Sequence, *, parents=None, gravity=(0, 0, -sp.Rational(981, 100)),
+             name: str = "poe_robot") -> SymbolicModel:
+    """A :class:`SymbolicModel` from joint twists, home link poses and link inertias with
+    sympy entries (or numbers): :func:`robodyn.from_poe`'s construction (Murray, Li & Sastry
+    ch. 3-4), revolute and prismatic joints. ``inertias``: per link ``(mass, com, inertia)``
+    in the link frame (``inertia`` 3 x 3 about the centre of mass)."""
+    from ..io.poe import poe_tree
+
+    sym = lambda x: sp.Matrix(x).applyfunc(exact)  # noqa: E731 (floats become exact rationals)
+    tree = poe_tree([sym(list(t)) for t in twists], [sym(g) for g in home], parents, where="symbolic.from_poe")
+    inertias = list(inertias)
+    if len(inertias) != len(tree):
+        raise ModelError(f"symbolic.from_poe: {len(tree)} twists need {len(tree)} inertias, got {len(inertias)}")
+    types, theta = [], []
+    for i, ((kind, *_rest, offset), (mass, com, Ic)) in enumerate(zip(tree, inertias)):
+        if kind not in JOINT_TYPES:
+            raise ModelError(f"symbolic.from_poe: joint {i + 1}: {kind} joints are not derived symbolically")
+        types.append(kind)
+        theta.append([sp.expand(t) for t in inertial_parameters(mass, _vec(com, 3, "com") + offset, Ic)])
+    return SymbolicModel(parent=tuple(t[1] for t in tree), joint_type=tuple(types),
+                         joint_axis=tuple(t[2] for t in tree), X_tree_R=tuple(t[4] for t in tree),
+                         X_tree_p=tuple(t[5] for t in tree), theta=tuple(theta), gravity=list(gravity), name=name)
