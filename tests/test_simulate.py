@@ -11,6 +11,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import robodyn as rd
+from robodyn import control
 from robodyn.random import random_model, random_state
 from robodyn.simulation import read_trajectory
 from robodyn.simulation.simulate import Progress
@@ -380,3 +381,44 @@ def test_bad_wrenches_and_constraints_are_refused():
                     contacts=Contacts([Sphere("body", 0.1)]))
     with pytest.raises(ValueError, match="baumgarte"):
         rd.simulate(body, [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3, constraints=[pin], baumgarte=(-1.0, 0.0))
+
+
+def test_symplectic_energy_stays_bounded_where_euler_drifts():
+    """Stormer-Verlet in momentum form on the double pendulum, 20,000 steps (100 s): the
+    energy error oscillates without drift (the last quarter's largest error is no larger than
+    the first quarter's, within 50 %), while the velocity-form semi-implicit Euler step gains
+    energy steadily. (1e5 steps: benchmarks/energy_drift.py, RESULTS.md.)"""
+    model = rd.models.load("double_pendulum")
+    q0, v0 = np.array([1.0, -0.5]), np.zeros(2)
+    run = rd.simulate(model, q0, v0, 100.0, 5e-3, integrator="symplectic")
+    error = np.abs(run.energy - run.energy[0])
+    quarter = len(error) // 4
+    assert error[-quarter:].max() <= 1.5 * error[:quarter].max()
+    assert error.max() < 0.02 * abs(run.energy[0])
+    euler = rd.simulate(model, q0, v0, 100.0, 5e-3, integrator="semi_implicit_euler")
+    drift = np.abs(euler.energy - euler.energy[0])
+    assert drift[-quarter:].max() > 10 * error.max()
+
+
+def test_symplectic_is_second_order_and_forced_runs_agree_with_rk4():
+    """Halving dt divides the error at t = 1 by about 4 (against RK4 at dt / 64), unforced and
+    under a PD controller with friction (the forcing enters at both ends of each step)."""
+    model = rd.models.load("double_pendulum").replace(damping=np.array([0.2, 0.1]))
+    q0, v0 = np.array([1.0, -0.5]), np.array([0.3, 0.0])
+    pd = control.PDGravity(model, np.array([0.2, 0.1]), 20.0, 5.0)
+    for controller in (None, pd):
+        exact = rd.simulate(model, q0, v0, 1.0, 1e-2 / 64, controller=controller, integrator="rk4")
+        errors = []
+        for dt in (1e-2, 5e-3, 2.5e-3):
+            run = rd.simulate(model, q0, v0, 1.0, dt, controller=controller, integrator="symplectic")
+            errors.append(np.abs(run.q[-1] - exact.q[-1]).max())
+        ratios = np.array(errors[:-1]) / np.array(errors[1:])
+        assert np.all((ratios > 3.5) & (ratios < 4.6)), (controller, errors, ratios)
+
+
+def test_symplectic_refuses_what_it_does_not_integrate():
+    ball = rd.ModelBuilder()
+    ball.add_link("body", mass=1.0, inertia=0.01 * np.eye(3))
+    with pytest.raises(ValueError, match="integrator 'symplectic': fixed-base models of 1-dof joints"):
+        rd.simulate(ball.build(floating_base=True), [0, 0, 0, 0, 0, 0, 1], np.zeros(6), 0.1, 1e-3,
+                    integrator="symplectic")

@@ -277,7 +277,7 @@ def cmd_torques(args) -> int:
 
 def add_commands(sub) -> None:
     """Register ``simulate`` and ``torques`` on the ``robodyn`` subcommand parser."""
-    from ..simulation import INTEGRATORS, SCIPY_INTEGRATORS
+    from ..simulation import INTEGRATORS, SCIPY_INTEGRATORS, SYMPLECTIC
 
     p = sub.add_parser("simulate", help="simulate the robot, free or under a controller; plots, GIF, CSV")
     add_model_arguments(p)
@@ -286,8 +286,9 @@ def add_commands(sub) -> None:
                         "the floating base unactuated (the default with --ground)")
     p.add_argument("--duration", type=float, default=5.0, help="seconds (default 5)")
     p.add_argument("--dt", type=float, default=1e-3, help="sample time and fixed step, seconds (default 0.001)")
-    p.add_argument("--integrator", choices=INTEGRATORS + SCIPY_INTEGRATORS, default=None,
-                   help="rk4 (default), semi_implicit_euler (the default and only one with --ground), or SciPy's")
+    p.add_argument("--integrator", choices=INTEGRATORS + (SYMPLECTIC,) + SCIPY_INTEGRATORS, default=None,
+                   help="rk4 (default), semi_implicit_euler (the default and only one with --ground), symplectic "
+                        "(energy bounded over long runs; fixed bases), or SciPy's")
     p.add_argument("--ground", action="store_true",
                    help="drop the robot onto the ground plane z = 0 (a URDF is loaded with a floating base)")
     p.add_argument("--contacts", help="--ground: links or frames touching it, comma-separated (default: the tip "

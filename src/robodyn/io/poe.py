@@ -90,11 +90,13 @@ def poe_tree(twists, home, parents=None, where: str = "from_poe"):
         R, p = g[:3, :3], ops.vec([g[k, 3] for k in range(3)])
         if ops.is_zero(w):
             if not ops.symbolic and abs(np.linalg.norm(v) - 1.0) > AXIS_TOL:
-                raise ModelError(f"{where}: joint {i + 1}: a prismatic twist (0, v) needs |v| = 1, got {np.linalg.norm(v):.6g}")
+                raise ModelError(f"{where}: joint {i + 1}: a prismatic twist (0, v) needs |v| = 1, "
+                                 f"got {np.linalg.norm(v):.6g}")
             kind, axis, pitch, origin = "prismatic", v, 0, p
         else:
             if not ops.symbolic and abs(np.linalg.norm(w) - 1.0) > AXIS_TOL:
-                raise ModelError(f"{where}: joint {i + 1}: a rotation twist (v, w) needs |w| = 1, got {np.linalg.norm(w):.6g}")
+                raise ModelError(f"{where}: joint {i + 1}: a rotation twist (v, w) needs |w| = 1, "
+                                 f"got {np.linalg.norm(w):.6g}")
             pitch = ops.dot(w, v)
             on_axis = ops.cross(w, v)                   # the point of the axis nearest the base origin
             origin = on_axis + w * ops.dot(w, p - on_axis)  # ... and nearest the link frame's origin

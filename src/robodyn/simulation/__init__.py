@@ -6,11 +6,11 @@
 robodyn's one tabular format (:mod:`robodyn.io.log`).
 """
 
-from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, simulate
+from .simulate import INTEGRATORS, SCIPY_INTEGRATORS, SYMPLECTIC, simulate
 from ..io.log import coordinate_names, read_csv, read_log, read_trajectory, write_log
 from .trajectory import Trajectory
 from .linearize import linearize
 from .rollout import Rollouts, rollout
 
 __all__ = ["simulate", "rollout", "Rollouts", "linearize", "Trajectory", "read_trajectory", "read_log", "write_log",
-           "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS"]
+           "read_csv", "coordinate_names", "INTEGRATORS", "SCIPY_INTEGRATORS", "SYMPLECTIC"]

@@ -31,6 +31,7 @@ from . import _kernels as K
 from .trajectory import Trajectory
 
 INTEGRATORS = ("semi_implicit_euler", "rk4")
+SYMPLECTIC = "symplectic"  # Störmer-Verlet in momentum form (simulation/symplectic.py), fixed bases
 SCIPY_INTEGRATORS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
 
 # Runs of at least this many steps show a progress bar (when stderr is a terminal).
@@ -221,7 +222,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             integrated with the robot from ``z' = state_rate(t, q, v, z)``.
         integrator: ``"rk4"`` (classic 4th-order Runge-Kutta in the manifold chart; the
             default without contacts), ``"semi_implicit_euler"`` (the default and the only
-            one with contacts) (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), or a SciPy
+            one with contacts) (``v+ = v + dt a(q, v)``, ``q+ = q ⊞ dt v+``), ``"symplectic"``
+            (Störmer-Verlet in momentum form, :mod:`robodyn.simulation.symplectic`: second
+            order, the energy of an unforced robot stays bounded over any number of steps;
+            fixed bases of 1-dof joints, from Python), or a SciPy
             ``solve_ivp`` method (``"RK45"``, ``"DOP853"``, ``"Radau"``, ...), adaptive between
             samples with tolerances ``rtol``, ``atol``, restarted in a new chart at each sample.
         contacts: a :class:`robodyn.contact.Contacts` (shapes on the bodies, surfaces of the
@@ -272,8 +276,13 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
                              f"stepping is 'semi_implicit_euler' (the default)")
     if integrator is None:
         integrator = "rk4" if contacts is None else "semi_implicit_euler"
-    if integrator not in INTEGRATORS + SCIPY_INTEGRATORS:
-        raise ValueError(f"integrator: unknown {integrator!r}; choose one of {INTEGRATORS + SCIPY_INTEGRATORS}")
+    if integrator not in INTEGRATORS + SCIPY_INTEGRATORS + (SYMPLECTIC,):
+        raise ValueError(f"integrator: unknown {integrator!r}; choose one of "
+                         f"{INTEGRATORS + (SYMPLECTIC,) + SCIPY_INTEGRATORS}")
+    if integrator == SYMPLECTIC and (model.nq != model.nv or constraints):
+        raise ValueError("integrator 'symplectic': fixed-base models of 1-dof joints without constraints only "
+                         f"(this one has nq = {model.nq}, nv = {model.nv}{', constraints' if constraints else ''}); "
+                         "use 'rk4'")
     if controller is not None and not callable(controller):
         raise ValueError(f"controller: expected None or a callable (t, q, v) -> tau, got {type(controller).__name__}")
     cmodel = getattr(controller, "model", None)
@@ -311,6 +320,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
         touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar)
     elif compiled is not None:
         _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
+    elif integrator == SYMPLECTIC:
+        from .symplectic import run_symplectic
+
+        run_symplectic(plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
     elif integrator in INTEGRATORS:
         _run_fixed_step(plant, integrator, law, q0, v0, dt, t, Q, V, Z, A, T, bar)
     else:
