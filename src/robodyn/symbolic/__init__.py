@@ -9,8 +9,9 @@
     print(eom.latex())                                    # LaTeX document
 
 Symbolic models (:class:`SymbolicModel`) come from a numeric model (:func:`from_model`), a
-DH table with symbols (:func:`from_dh`), or either with named inertial parameters
-(:func:`with_inertia_symbols`); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``
+DH table with symbols (:func:`from_dh`), joint twists (:func:`from_poe`), or either with named
+inertial parameters (:func:`with_inertia_symbols`); :mod:`.textbook` has the textbooks'
+robots (``textbook.scara_mls()``, ``elbow_mls()``, ``planar_2r_mls()``); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``
 and ``tau`` from the recursions without the expanded derivation; :func:`regressor` gives
 ``Y(q, v, a)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
 """
@@ -20,8 +21,9 @@ from .model import (SymbolicModel, from_dh, from_model, from_poe, inertia_symbol
                     with_inertia_symbols)
 from .recursive import RecursiveDynamics, recursive_dynamics
 from .regressor import Regressor, regressor
+from . import textbook
 
 __all__ = [
-    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "from_dh", "from_poe",
+    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "textbook", "from_dh", "from_poe",
     "from_model", "inertia_symbols", "inertial_parameters", "recursive_dynamics", "regressor", "with_inertia_symbols",
 ]
