@@ -5,6 +5,7 @@ robot built numerically."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import sympy as sp
 
 import robodyn as rd
@@ -74,3 +75,42 @@ def test_the_numbers_agree_with_the_numeric_kernels():
               np.diag([values[sp.Symbol(f"{k}{i}", positive=True)] for k in ("Ix", "Iy", "Iz")])) for i in (1, 2, 3)]
     numeric = rd.from_poe(twists, [at((0, 0, r0)), at((0, r1, l0)), at((0, l1 + r2, l0))], links)
     assert_rel(rd.crba(numeric, q), M, 1e-12)
+
+
+def test_symbolic_builder_two_rods():
+    """The lecture's arm with symbols, one line per link (rd.inertia with symbols): Spong's
+    closed form of M(q), exactly; a fixed joint merges a tool mass into link 2 as the numeric
+    builder does."""
+    m1, m2, l1, l2, mt, g = sp.symbols("m1 m2 l1 l2 mt g", positive=True)
+    b = rd.symbolic.ModelBuilder("arm", gravity=(0, -g, 0))
+    b.add_link("link1", mass=m1, com=(l1 / 2, 0, 0), inertia=rd.inertia.rod(m1, l1, "x"))
+    b.add_link("link2", mass=m2, com=(l2 / 2, 0, 0), inertia=rd.inertia.rod(m2, l2, "x"))
+    b.add_joint("joint1", "revolute", "world", "link1", axis=(0, 0, 1))
+    b.add_joint("joint2", "revolute", "link1", "link2", xyz=(l1, 0, 0), axis=(0, 0, 1))
+    model = b.build()
+    assert model.link_names == ("link1", "link2") and model.joint_names == ("joint1", "joint2")
+    eom = rd.symbolic.equations_of_motion(model)
+    c2 = sp.cos(eom.q[1])
+    r1, r2, I1, I2 = l1 / 2, l2 / 2, m1 * l1**2 / 12, m2 * l2**2 / 12
+    a, bb, d = I1 + I2 + m1 * r1**2 + m2 * (l1**2 + r2**2), m2 * l1 * r2, I2 + m2 * r2**2
+    assert sp.simplify(eom.M - sp.Matrix([[a + 2 * bb * c2, d + bb * c2], [d + bb * c2, d]])) == sp.zeros(2)
+    # a point mass on a fixed joint at the tip, turned: merged into link 2 exactly
+    b.add_link("tool", mass=mt)
+    b.add_joint("tool_fixed", "fixed", "link2", "tool", xyz=(l2, 0, 0), rotation=sp.Matrix([[0, -1, 0], [1, 0, 0],
+                                                                                          [0, 0, 1]]))
+    with_tool = b.build()
+    values = {m1: 2.0, m2: 1.5, l1: 0.7, l2: 0.5, mt: 0.3, g: 9.81}
+    nb = rd.ModelBuilder("arm", gravity=(0, -9.81, 0))
+    nb.add_link("link1", mass=2.0, com=(0.35, 0, 0), inertia=rd.inertia.rod(2.0, 0.7, "x"))
+    nb.add_link("link2", mass=1.5, com=(0.25, 0, 0), inertia=rd.inertia.rod(1.5, 0.5, "x"))
+    nb.add_link("tool", mass=0.3)
+    nb.add_joint("joint1", "revolute", "world", "link1", axis=(0, 0, 1))
+    nb.add_joint("joint2", "revolute", "link1", "link2", xyz=(0.7, 0, 0), axis=(0, 0, 1))
+    nb.add_joint("tool_fixed", "fixed", "link2", "tool", xyz=(0.5, 0, 0), rpy=(0, 0, np.pi / 2))
+    numeric = nb.build()
+    theta = np.array([[float(sp.sympify(x).subs(values)) for x in th] for th in with_tool.theta])
+    assert_rel(theta, numeric.theta, 1e-12)
+    with pytest.raises(rd.ModelError, match="a symbolic model has"):
+        b.add_joint("ball", "spherical", "link2", "tool")
+    with pytest.raises(rd.ModelError, match="axis must be a unit vector"):
+        b.add_joint("j3", "revolute", "link2", "tool", axis=(0, 0, 2))

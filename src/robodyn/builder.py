@@ -56,7 +56,9 @@ def rpy_to_matrix(rpy) -> np.ndarray:
 
 
 @dataclass
-class _Link:
+class LinkEntry:
+    """A link as added: its 10 inertial parameters and where it was defined."""
+
     name: str
     theta: np.ndarray
     where: str
@@ -72,7 +74,9 @@ class _Link:
 
 
 @dataclass
-class _Joint:
+class JointEntry:
+    """A joint as added: type, parent and child links, placement, axis, limits."""
+
     name: str
     type: str
     parent: str
@@ -99,8 +103,8 @@ class ModelBuilder:
         self.name = name
         self.gravity = np.asarray(gravity, dtype=float)
         self.source = source
-        self._links: dict[str, _Link] = {}
-        self._joints: list[_Joint] = []
+        self._links: dict[str, LinkEntry] = {}
+        self._joints: list[JointEntry] = []
 
     def add_link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None,
                  inertia_rotation=None, where: str | None = None) -> None:
@@ -122,9 +126,9 @@ class ModelBuilder:
             Ic = Rr @ Ic @ Rr.T
         if mass < 0:
             raise ModelError(f"{where}: negative mass {mass}")
-        self._links[name] = _Link(name, inertial_parameters_from(mass, com, Ic), where)
+        self._links[name] = LinkEntry(name, inertial_parameters_from(mass, com, Ic), where)
 
-    def _check_body(self, theta, name: str, links: list[_Link]) -> None:
+    def _check_body(self, theta, name: str, links: list[LinkEntry]) -> None:
         """Check the merged body ``name`` (``theta``), made of ``links``; raise (or warn, with
         ``physical="warn"``) naming each link and what it carries."""
         where = f"{self.source}: body {name!r}"
@@ -204,7 +208,7 @@ class ModelBuilder:
             raise ModelError(f"{where}: lower limit {lower} exceeds upper limit {upper}")
         if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
             raise ModelError(f"{where}: pitch {pitch} on a {type} joint (only a helical joint has a finite pitch)")
-        self._joints.append(_Joint(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
+        self._joints.append(JointEntry(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
 
     def _add_universal(self, name, parent, child, xyz, rpy, axis, axis2, rotation, where, options) -> None:
         if axis2 is None:
@@ -226,16 +230,16 @@ class ModelBuilder:
         self.add_joint(f"{name}[2]", "revolute", cross, child, axis=a2, where=where, **split[1])
 
     # ---------------------------------------------------------------------------------
-    def _check_graph(self) -> tuple[str, dict[str, list[_Joint]]]:
+    def _check_graph(self) -> tuple[str, dict[str, list[JointEntry]]]:
         """Return the root link and the child joints of each link, or raise ModelError. A
         parent link ``"world"`` that was not added is the implicit, massless root."""
         if WORLD not in self._links and any(jt.parent == WORLD for jt in self._joints):
-            self._links[WORLD] = _Link(WORLD, np.zeros(10), f"{self.source}: link 'world' (implicit: the root)")
+            self._links[WORLD] = LinkEntry(WORLD, np.zeros(10), f"{self.source}: link 'world' (implicit: the root)")
         if not self._links:
             raise ModelError(f"{self.source}: no links")
-        seen_joint: dict[str, _Joint] = {}
-        parent_joint: dict[str, _Joint] = {}
-        children: dict[str, list[_Joint]] = {name: [] for name in self._links}
+        seen_joint: dict[str, JointEntry] = {}
+        parent_joint: dict[str, JointEntry] = {}
+        children: dict[str, list[JointEntry]] = {name: [] for name in self._links}
         for jt in self._joints:
             if jt.name in seen_joint:
                 raise ModelError(f"{jt.where}: duplicate joint name {jt.name!r} (first at {seen_joint[jt.name].where})")
@@ -266,7 +270,7 @@ class ModelBuilder:
             raise ModelError(self._cycle_message(next(n for n in self._links if n not in reached), parent_joint))
         return roots[0], children
 
-    def _cycle_message(self, link: str, parent_joint: dict[str, _Joint]) -> str:
+    def _cycle_message(self, link: str, parent_joint: dict[str, JointEntry]) -> str:
         """Name the joints of the cycle upstream of ``link`` (which is not reachable from a root)."""
         path, seen = [], {}
         while link not in seen:  # walk parents; every link on the way has exactly one
@@ -325,7 +329,7 @@ class ModelBuilder:
                 place[jt.child] = (nb, np.eye(3), np.zeros(3))
             order.append(jt.child)
             stack.extend(reversed(children[jt.child]))
-        members: list[list[_Link]] = [[] for _ in theta]
+        members: list[list[LinkEntry]] = [[] for _ in theta]
         for link in order:
             b, R, p = place[link]
             if b < 0:

@@ -9,13 +9,15 @@
     print(eom.latex())                                    # LaTeX document
 
 Symbolic models (:class:`SymbolicModel`) come from a numeric model (:func:`from_model`), a
-DH table with symbols (:func:`from_dh`), joint twists (:func:`from_poe`), or either with named
+DH table with symbols (:func:`from_dh`), joint twists (:func:`from_poe`), links and joints
+(:class:`ModelBuilder`), or either with named
 inertial parameters (:func:`with_inertia_symbols`); :mod:`.textbook` has the textbooks'
 robots (``textbook.scara_mls()``, ``elbow_mls()``, ``planar_2r_mls()``); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``
 and ``tau`` from the recursions without the expanded derivation; :func:`regressor` gives
 ``Y(q, v, a)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
 """
 
+from .builder import ModelBuilder
 from .equations import EquationsOfMotion, equations_of_motion
 from .model import (SymbolicModel, from_dh, from_model, from_poe, inertia_symbols, inertial_parameters,
                     with_inertia_symbols)
@@ -24,6 +26,6 @@ from .regressor import Regressor, regressor
 from . import textbook
 
 __all__ = [
-    "EquationsOfMotion", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "textbook", "from_dh", "from_poe",
+    "EquationsOfMotion", "ModelBuilder", "RecursiveDynamics", "Regressor", "SymbolicModel", "equations_of_motion", "textbook", "from_dh", "from_poe",
     "from_model", "inertia_symbols", "inertial_parameters", "recursive_dynamics", "regressor", "with_inertia_symbols",
 ]

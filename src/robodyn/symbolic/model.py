@@ -61,14 +61,16 @@ def exact(x, snap: bool = False) -> sp.Expr:
     return sp.Rational(f.numerator, f.denominator)
 
 
-def _vec(x, n: int, what: str) -> sp.Matrix:
+def exact_vector(x, n: int, what: str) -> sp.Matrix:
+    """``x`` as an ``n x 1`` sympy matrix of exact entries (:func:`exact`); ``what`` names it in errors."""
     m = sp.Matrix(x) if not isinstance(x, sp.MatrixBase) else x
     if m.shape not in ((n, 1), (1, n)):
         raise ValueError(f"{what}: expected {n} entries, got shape {m.shape}")
     return sp.Matrix(n, 1, [exact(e) for e in m])
 
 
-def _mat3(x, what: str, snap: bool = False) -> sp.Matrix:
+def exact_matrix3(x, what: str, snap: bool = False) -> sp.Matrix:
+    """``x`` as a 3 x 3 sympy matrix of exact entries (:func:`exact`); ``what`` names it in errors."""
     m = sp.Matrix(x)
     if m.shape != (3, 3):
         raise ValueError(f"{what}: expected shape (3, 3), got {m.shape}")
@@ -85,8 +87,8 @@ def inertial_parameters(mass, com, inertia_com) -> list:
     (3,) and the inertia (3, 3) about the centre of mass (same frame), by the parallel-axis
     theorem ``I_o = I_c + m [c]x^T [c]x``; entries may be symbols."""
     m = exact(mass)
-    c = _vec(com, 3, "com")
-    Io = _mat3(inertia_com, "inertia") + m * (skew(c).T * skew(c))
+    c = exact_vector(com, 3, "com")
+    Io = exact_matrix3(inertia_com, "inertia") + m * (skew(c).T * skew(c))
     h = m * c
     return [m, h[0], h[1], h[2], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
 
@@ -141,11 +143,11 @@ class SymbolicModel:
             if len(self.theta[i]) != 10:
                 raise ModelError(f"body {i}: expected 10 inertial parameters, got {len(self.theta[i])}")
         set_("parent", tuple(int(p) for p in self.parent))
-        set_("joint_axis", tuple(_vec(a, 3, f"joint_axis[{i}]") for i, a in enumerate(self.joint_axis)))
-        set_("X_tree_R", tuple(_mat3(R, f"X_tree_R[{i}]") for i, R in enumerate(self.X_tree_R)))
-        set_("X_tree_p", tuple(_vec(p, 3, f"X_tree_p[{i}]") for i, p in enumerate(self.X_tree_p)))
+        set_("joint_axis", tuple(exact_vector(a, 3, f"joint_axis[{i}]") for i, a in enumerate(self.joint_axis)))
+        set_("X_tree_R", tuple(exact_matrix3(R, f"X_tree_R[{i}]") for i, R in enumerate(self.X_tree_R)))
+        set_("X_tree_p", tuple(exact_vector(p, 3, f"X_tree_p[{i}]") for i, p in enumerate(self.X_tree_p)))
         set_("theta", tuple(tuple(exact(t) for t in th) for th in self.theta))
-        set_("gravity", _vec(self.gravity, 3, "gravity"))
+        set_("gravity", exact_vector(self.gravity, 3, "gravity"))
         arm = tuple(exact(a) for a in self.armature) if self.armature else (sp.Integer(0),) * nb
         if len(arm) != nb:
             raise ModelError(f"armature: expected {nb} entries, got {len(arm)}")
@@ -297,8 +299,8 @@ def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Ra
         p_tree.append(X[:3, 3])
         # inertia given in DH frame i = body frame * post: move it into the body frame
         Rp, pp = post[:3, :3], post[:3, 3]
-        com = Rp * _vec(L.com, 3, f"{where}: com") + pp
-        Ic = Rp * _mat3(L.inertia, f"{where}: inertia") * Rp.T
+        com = Rp * exact_vector(L.com, 3, f"{where}: com") + pp
+        Ic = Rp * exact_matrix3(L.inertia, f"{where}: inertia") * Rp.T
         inertia.append([sp.expand(t) for t in inertial_parameters(L.mass, com, Ic)])
         types.append(L.joint)
         post_prev = post
@@ -328,7 +330,7 @@ def from_poe(twists, home, inertias: Sequence, *, parents=None, gravity=(0, 0, -
         if kind not in JOINT_TYPES:
             raise ModelError(f"symbolic.from_poe: joint {i + 1}: {kind} joints are not derived symbolically")
         types.append(kind)
-        theta.append([sp.expand(t) for t in inertial_parameters(mass, _vec(com, 3, "com") + offset, Ic)])
+        theta.append([sp.expand(t) for t in inertial_parameters(mass, exact_vector(com, 3, "com") + offset, Ic)])
     return SymbolicModel(parent=tuple(t[1] for t in tree), joint_type=tuple(types),
                          joint_axis=tuple(t[2] for t in tree), X_tree_R=tuple(t[4] for t in tree),
                          X_tree_p=tuple(t[5] for t in tree), theta=tuple(theta), gravity=list(gravity), name=name)
