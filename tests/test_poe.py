@@ -19,9 +19,9 @@ from helpers import RANDOM_MODELS, assert_rel, states
 
 
 def poe_description(model):
-    """``(twists, home, inertias, tool)`` of a serial chain of 1-dof joints: the columns of
-    the world Jacobian at q = 0 (the twists, MLS eq. 3.54), the body poses at q = 0 and the
-    bodies' (mass, com, inertia); the tool is the last body's frame."""
+    """``(twists, home, inertias, tool)`` of a tree of 1-dof joints: the columns of the world
+    Jacobian at q = 0 (the twists, MLS eq. 3.54), the body poses at q = 0 and the bodies'
+    (mass, com, inertia); the tool is the last body's frame."""
     q0 = np.zeros(model.nq)
     poses = rd.forward_kinematics(model, q0)
     twists = [rd.jacobian(model, q0, i, "world")[:, model.idx_v[i]] for i in range(model.nbodies)]
@@ -63,6 +63,20 @@ def test_generalized_inertia_matrices_and_a_helical_joint():
     assert screw.joint_type.tolist() == [rd.joints.HELICAL] and screw.joint_pitch.tolist() == [pytest.approx(0.05)]
     T = rd.frame_pose(screw, np.array([np.pi / 2]), "link1")
     assert_rel(T[:3, 3], [0.0, 0.0, 0.05 * np.pi / 2], 1e-12)
+
+
+def test_a_urdf_robot_from_twists():
+    """A URDF tree (Panda with its two finger joints, from example-robot-data) rebuilt from its
+    twists, with its parents: Pinocchio's file, the same dynamics."""
+    from conftest import example_robot_data_dir
+
+    with pytest.warns(rd.RobodynWarning, match="mimic joints loaded as independent joints"):
+        model = rd.load_urdf(example_robot_data_dir() / "panda_description/urdf/panda.urdf").rigid()
+    twists, home, inertias, _ = poe_description(model)
+    poe = rd.from_poe(twists, home, inertias, parents=model.parent, gravity=model.gravity)
+    q, v, a = states(model, "poe-urdf", size=3)
+    assert_rel(rd.rnea(poe, q, v, a), rd.rnea(model, q, v, a), 1e-12)
+    assert_rel(rd.crba(poe, q), rd.crba(model, q), 1e-12)
 
 
 @pytest.mark.parametrize("model", RANDOM_MODELS[:6])
