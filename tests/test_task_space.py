@@ -243,7 +243,8 @@ def test_bad_input():
     q, v, _ = states(model, "task-bad")
     with pytest.raises(ValueError, match=r"frame must be one of"):
         rd.task_space_inertia(model, q, "body8", frame="base")
-    with pytest.raises(ValueError, match=r"rows must be one of \('all', 'linear', 'angular'\), got 'xy'"):
+    with pytest.raises(ValueError,
+                       match=r"rows must be one of \('all', 'linear', 'angular'\) or a list of row indices 0-5, got 'xy'"):
         rd.dynamically_consistent_inverse(model, q, "body8", rows="xy")
     with pytest.raises(ValueError, match=r"unknown link or frame 'nope'"):
         rd.task_space_inertia(model, q, "nope")
@@ -253,3 +254,25 @@ def test_bad_input():
         rd.task_space_dynamics(model, q, np.full(model.nv, np.nan), "body8")
     with pytest.raises(ValueError, match=r"q contains NaN or Inf"):
         rd.task_space_inertia(model, np.full(model.nq, np.nan), "body8")
+
+
+def test_any_subset_of_rows():
+    """rows may list row indices: the x and z of a planar arm's tip (it moves in the x-z
+    plane), where rows="linear" is singular and says to choose fewer rows."""
+    model = rd.models.load("planar_2r")
+    q, v = np.array([0.3, 0.5]), np.array([0.4, -0.2])
+    J = rd.jacobian(model, q, "frame2", "local_world_aligned")[[0, 2]]
+    Minv = np.linalg.inv(rd.crba(model, q))
+    Lam = np.linalg.inv(J @ Minv @ J.T)
+    assert_rel(rd.task_space_inertia(model, q, "frame2", rows=[0, 2]), Lam, 1e-12)
+    assert_rel(rd.task_space_inertia(model, q, "frame2", rows=np.array([0, 2])), Lam, 1e-12)
+    assert_rel(rd.dynamically_consistent_inverse(model, q, "frame2", rows=(0, 2)), Minv @ J.T @ Lam, 1e-12)
+    terms = rd.task_space_dynamics(model, q, v, "frame2", rows=[0, 2])
+    assert_rel(terms.J, J, 1e-15)
+    Jdv = rd.jacobian_dot_times_v(model, q, v, "frame2", "local_world_aligned")[[0, 2]]
+    assert_rel(terms.mu, terms.Jbar.T @ (rd.nonlinear_effects(model, q, v) - rd.gravity(model, q)) - Lam @ Jdv, 1e-12)
+    with pytest.raises(ValueError, match=r"\(linear rows, frame 'local_world_aligned'\) is singular.*choose fewer rows"):
+        rd.task_space_inertia(model, q, "frame2", rows="linear")
+    for bad in ([0, 0], [6], [], ["a"], [0.5]):
+        with pytest.raises(ValueError, match="a list of distinct row indices 0-5"):
+            rd.task_space_inertia(model, q, "frame2", rows=bad)
