@@ -9,7 +9,8 @@
 
 from .controllers import (AdaptiveSlotineLi, ComputedTorque, Controller, JointPD, PDGravity, PIDGravity, SlotineLi,
                           TaskSpacePD)
+from .interaction import CartesianImpedance, rotation_vector
 from .references import PointToPoint, Sampled, cubic, quintic
 
-__all__ = ["Controller", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
+__all__ = ["Controller", "CartesianImpedance", "rotation_vector", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
            "cubic", "quintic", "AdaptiveSlotineLi", "JointPD"]

@@ -1,0 +1,93 @@
+"""Interaction control: a frame of the robot behaves as a spring and damper about a desired
+pose, so that contact forces stay bounded and predictable.
+
+:class:`CartesianImpedance` (Hogan 1985; Siciliano et al., *Robotics* (2009), section 9.3,
+impedance control without inertia shaping, with gravity compensation):
+
+    tau = J^T (K e - D J v) - D_q v + g(q),    e = [x_d - x; log(R_d R^T)]   (world axes)
+
+``J`` (6, nv) is the Jacobian of the frame's origin in world axes (``"local_world_aligned"``),
+``log(R_d R^T)`` the rotation vector of the orientation error, ``K``, ``D`` (6,) the
+stiffness and damping of the spring ``[linear; angular]`` and ``D_q`` a joint damping for the
+redundant directions. At rest under an external wrench ``w = [f; n]`` on the frame (world
+axes, torque about its origin) the frame sits where the spring balances it:
+``K e = -w``, a displacement ``f / K`` and a rotation by the vector ``n / K`` (the rotation
+error is the exact rotation vector, so this holds for large rotations too), whatever the
+arm's configuration, as long as ``J`` has full row rank. Orientation may be left free
+(``orientation=None``: three task rows, the position only).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..algorithms.jacobian import jacobian
+from ..algorithms.kinematics import frame_pose
+from ..algorithms.terms import gravity
+from .controllers import Controller, gain
+
+
+def rotation_vector(R: np.ndarray) -> np.ndarray:
+    """The rotation vector ``theta u`` of a rotation matrix (the log map of SO(3)), with
+    ``theta`` in ``[0, pi]``; accurate near 0 and near pi."""
+    cos = np.clip((np.trace(R) - 1.0) / 2.0, -1.0, 1.0)
+    w = np.array([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]])
+    sin = 0.5 * np.linalg.norm(w)
+    theta = np.arctan2(sin, cos)
+    if sin > 1e-6:
+        return theta / (2.0 * sin) * w
+    if cos > 0:  # near the identity: theta / sin(theta) -> 1
+        return 0.5 * (1.0 + theta * theta / 6.0) * w
+    # near pi: the axis from the symmetric part, R + R^T = 2 cos 1 + 2 (1 - cos) u u^T
+    B = (R + R.T - 2.0 * cos * np.eye(3)) / (2.0 * (1.0 - cos))
+    k = int(np.argmax(np.diag(B)))
+    u = B[:, k] / np.sqrt(B[k, k])
+    return theta * (u if w @ u >= 0 else -u)
+
+
+class CartesianImpedance(Controller):
+    """Impedance control of a link or frame ``body`` about a desired pose (module docstring).
+
+    Args:
+        body: a link or frame name of ``model``.
+        position: (3,) desired origin in the world frame.
+        orientation: (3, 3) desired rotation in the world frame, or None to leave it free.
+        stiffness, damping: the spring's ``K`` and ``D``: numbers or (3,) for the position,
+            and (with an orientation) (6,) vectors ``[linear; angular]`` or pairs
+            ``(linear, angular)``.
+        joint_damping: ``D_q``, > 0 (numbers or (nv,)).
+    """
+
+    def __init__(self, model, body: str, position, orientation=None, *, stiffness, damping, joint_damping=1.0):
+        super().__init__(model)
+        self.body = body
+        model.frame_index(body)  # raises for an unknown name
+        self.x_d = np.array(position, dtype=float)
+        if self.x_d.shape != (3,) or not np.all(np.isfinite(self.x_d)):
+            raise ValueError(f"position: expected 3 finite numbers, got shape {self.x_d.shape}")
+        self.R_d = None if orientation is None else np.array(orientation, dtype=float)
+        if self.R_d is not None and (self.R_d.shape != (3, 3) or not np.allclose(self.R_d @ self.R_d.T, np.eye(3),
+                                                                               atol=1e-9)):
+            raise ValueError("orientation: expected a 3 x 3 rotation matrix")
+        m = 3 if self.R_d is None else 6
+        self.K, self.D = self._gains("stiffness", stiffness, m), self._gains("damping", damping, m)
+        self.joint_damping = gain("joint_damping", joint_damping, model.nv)
+
+    @staticmethod
+    def _gains(name, value, m):
+        if m == 6 and isinstance(value, tuple) and len(value) == 2:
+            value = np.concatenate([np.broadcast_to(np.asarray(v, dtype=float), (3,)) for v in value])
+        return gain(name, value, m)
+
+    def error(self, q) -> np.ndarray:
+        """``e = [x_d - x; log(R_d R^T)]`` (3 or 6,) in world axes."""
+        T = frame_pose(self.model, q, self.body)
+        e = self.x_d - T[:3, 3]
+        if self.R_d is None:
+            return e
+        return np.concatenate([e, rotation_vector(self.R_d @ T[:3, :3].T)])
+
+    def __call__(self, t, q, v):
+        J = jacobian(self.model, q, self.body, "local_world_aligned")[:self.K.shape[0]]
+        f = self.K * self.error(q) - self.D * (J @ v)
+        return J.T @ f - self.joint_damping * v + gravity(self.model, q)

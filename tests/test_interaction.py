@@ -1,0 +1,73 @@
+"""Interaction control (robodyn.control.interaction): under a known external wrench on the
+frame, an impedance-controlled Panda settles where the spring balances it, a displacement
+f / K and a rotation by the vector n / K (within 1 %); the rotation error is SciPy's rotation
+vector; bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import robodyn as rd
+from robodyn import control
+
+from helpers import assert_rel, rng_for
+
+Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.6, 0.8])
+
+
+def settle(ctrl, model, wrench, duration=2.0):
+    """The frame's pose after ``duration`` s under ``wrench`` (world axes, about its origin)."""
+    F = np.zeros((model.nbodies, 6))
+    F[model.frame_index(ctrl.body)[0]] = wrench
+    run = rd.simulate(model, Q0, np.zeros(model.nv), duration, 2e-3, controller=ctrl, f_ext=F,
+                      frame="local_world_aligned")
+    assert np.abs(run.v[-1]).max() < 1e-4, "not at rest"
+    return rd.frame_pose(model, run.q[-1], ctrl.body)
+
+
+def test_the_frame_yields_like_its_spring():
+    model = rd.models.load("panda").rigid()
+    T0 = rd.frame_pose(model, Q0, "link7")
+    K, D = np.array([800.0, 600.0, 700.0, 40.0, 30.0, 50.0]), np.array([80.0, 70.0, 75.0, 2.0, 2.0, 2.5])
+    ctrl = control.CartesianImpedance(model, "link7", T0[:3, 3], T0[:3, :3], stiffness=K, damping=D)
+    wrench = np.array([8.0, -4.0, 6.0, 0.4, -0.2, 0.3])
+    T = settle(ctrl, model, wrench)
+    assert_rel(T[:3, 3] - T0[:3, 3], wrench[:3] / K[:3], 0.01 * np.abs(wrench[:3] / K[:3]).max())
+    turn = Rotation.from_matrix(T[:3, :3] @ T0[:3, :3].T).as_rotvec()
+    assert_rel(turn, wrench[3:] / K[3:], 0.01 * np.abs(wrench[3:] / K[3:]).max())
+
+
+def test_position_only_leaves_the_orientation_free():
+    model = rd.models.load("panda").rigid()
+    T0 = rd.frame_pose(model, Q0, "link7")
+    ctrl = control.CartesianImpedance(model, "link7", T0[:3, 3], stiffness=500.0, damping=60.0, joint_damping=2.0)
+    force = np.array([0.0, 5.0, -5.0, 0.0, 0.0, 0.0])
+    T = settle(ctrl, model, force)
+    assert_rel(T[:3, 3] - T0[:3, 3], force[:3] / 500.0, 1e-4)
+
+
+def test_rotation_vector_is_the_log_map():
+    rng = rng_for("rotation-vector")
+    for angle in (0.0, 1e-9, 1e-4, 0.3, 2.0, np.pi - 1e-5, np.pi):
+        for _ in range(5):
+            u = rng.standard_normal(3)
+            r = angle * u / np.linalg.norm(u)
+            got = control.rotation_vector(Rotation.from_rotvec(r).as_matrix())
+            if angle == np.pi:  # +u and -u are the same rotation
+                assert min(np.abs(got - r).max(), np.abs(got + r).max()) < 1e-7
+            else:
+                assert_rel(got, r, 1e-7 if angle > np.pi - 1e-3 else 1e-12, f"angle {angle}")
+
+
+def test_bad_input():
+    model = rd.models.load("panda")
+    with pytest.raises(ValueError, match="unknown"):
+        control.CartesianImpedance(model, "nowhere", np.zeros(3), stiffness=1.0, damping=1.0)
+    with pytest.raises(ValueError, match="position: expected 3 finite numbers"):
+        control.CartesianImpedance(model, "link7", [0.0, np.nan, 0.0], stiffness=1.0, damping=1.0)
+    with pytest.raises(ValueError, match="orientation: expected a 3 x 3 rotation matrix"):
+        control.CartesianImpedance(model, "link7", np.zeros(3), 2 * np.eye(3), stiffness=1.0, damping=1.0)
+    with pytest.raises(ValueError, match=r"stiffness: gains must be finite and > 0"):
+        control.CartesianImpedance(model, "link7", np.zeros(3), np.eye(3), stiffness=(100.0, -1.0), damping=1.0)
