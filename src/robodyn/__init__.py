@@ -31,6 +31,7 @@ _LAZY = {
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
     "slotine_li_regressor": "regressor", "rnea_derivatives": "rnea_derivatives",
     "aba_derivatives": "aba_derivatives", "mass_matrix_from_jacobians": "mass_jacobians",
+    "inertia_bounds": "inertia_bounds",
 }
 # Applications, also imported on first use: name -> module.
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
@@ -73,7 +74,7 @@ __all__ = [
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",
     "WeldConstraint", "LoopConstraint", "DistanceConstraint", "CouplingConstraint", "task_space_inertia",
-    "mass_matrix_from_jacobians",
+    "mass_matrix_from_jacobians", "inertia_bounds",
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf", "write_mjcf",

@@ -13,6 +13,13 @@ from __future__ import annotations
 import numpy as np
 
 
+def _revolute_model():
+    """A built-in robot of revolute joints only (inertia_bounds takes no other)."""
+    from .models import load
+
+    return load("pendulum")
+
+
 def _algorithm_steps(rd, model, q, v, a):
     """``(name, call)`` of every public algorithm with compiled kernels, at state ``(q, v, a)``."""
     last = model.nbodies - 1
@@ -34,6 +41,7 @@ def _algorithm_steps(rd, model, q, v, a):
         ("jacobian", lambda: rd.jacobian(model, q, last)),
         ("jacobian_dot_times_v", lambda: rd.jacobian_dot_times_v(model, q, v, last)),
         ("mass_matrix_from_jacobians", lambda: rd.mass_matrix_from_jacobians(model, q)),
+        ("inertia_bounds", lambda: rd.inertia_bounds(_revolute_model(), max_boxes=3)),
         ("frame_velocity_derivatives", lambda: rd.frame_velocity_derivatives(model, q, v, last)),
         ("frame_acceleration_derivatives", lambda: rd.frame_acceleration_derivatives(model, q, v, a, last)),
         ("forward_kinematics", lambda: rd.forward_kinematics(model, q)),
@@ -95,14 +103,14 @@ def _public():
 
     from . import random
     from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives,
-                             hybrid, integrate, jacobian, kinematics, mass_jacobians, minv, regressor, rnea,
-                             rnea_derivatives, task_space, terms)
+                             hybrid, inertia_bounds, integrate, jacobian, kinematics, mass_jacobians, minv,
+                             regressor, rnea, rnea_derivatives, task_space, terms)
     from .simulation import rollout, simulate
 
     names = {}
     for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives, hybrid,
-                   integrate, jacobian, kinematics, mass_jacobians, minv, regressor, rnea, rnea_derivatives, task_space,
-                   terms):
+                   inertia_bounds, integrate, jacobian, kinematics, mass_jacobians, minv, regressor, rnea,
+                   rnea_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module)
                       if not n.startswith("_") and not isinstance(getattr(module, n), ModuleType)})
     return SimpleNamespace(**names, simulate=simulate, rollout=rollout, random=random)
