@@ -15,6 +15,17 @@ axes, torque about its origin) the frame sits where the spring balances it:
 error is the exact rotation vector, so this holds for large rotations too), whatever the
 arm's configuration, as long as ``J`` has full row rank. Orientation may be left free
 (``orientation=None``: three task rows, the position only).
+
+:class:`HybridForcePosition` (Raibert & Craig 1981, with the selection given by a surface
+normal ``n``; Siciliano et al. (2009), section 9.6): the frame pushes with force ``f_d`` along
+``-n`` (into the surface) and follows a path in the surface's plane,
+
+    F = P (K (x_d(t) - x) - D x') - f_d n - D_n n n^T x',   P = 1 - n n^T,
+    tau = J^T F - D_q v + g(q)
+
+(``J`` the (3, nv) Jacobian of the frame's origin in world axes). Against a rigid surface the
+normal contact force settles at ``f_d`` exactly (the commanded force is what the surface must
+return at rest), and stays there while the frame slides along the path.
 """
 
 from __future__ import annotations
@@ -91,3 +102,44 @@ class CartesianImpedance(Controller):
         J = jacobian(self.model, q, self.body, "local_world_aligned")[:self.K.shape[0]]
         f = self.K * self.error(q) - self.D * (J @ v)
         return J.T @ f - self.joint_damping * v + gravity(self.model, q)
+
+
+class HybridForcePosition(Controller):
+    """Force along a surface normal, position in its plane (module docstring).
+
+    Args:
+        body: the link or frame in contact.
+        normal: (3,) the surface's outward unit normal in world axes (the surface pushes the
+            frame along it).
+        force: ``f_d`` (N), the normal force to hold, > 0.
+        path: a callable ``t -> x_d`` (3,) (world), its component along ``normal`` ignored.
+        stiffness, damping: ``K``, ``D`` of the position control in the plane (numbers).
+        normal_damping: ``D_n``, damping of the approach along the normal.
+        joint_damping: ``D_q`` (numbers or (nv,)).
+    """
+
+    def __init__(self, model, body: str, normal, force: float, path, *, stiffness, damping,
+                 normal_damping=None, joint_damping=1.0):
+        super().__init__(model)
+        model.frame_index(body)
+        self.body = body
+        self.n = np.array(normal, dtype=float)
+        if self.n.shape != (3,) or abs(np.linalg.norm(self.n) - 1.0) > 1e-9:
+            raise ValueError(f"normal: expected a unit vector (3,), got {normal!r}")
+        if not (np.isfinite(force) and force > 0):
+            raise ValueError(f"force: expected a number > 0, got {force!r}")
+        if not callable(path):
+            raise ValueError(f"path: expected a callable t -> (3,) position, got {type(path).__name__}")
+        self.force, self.path = float(force), path
+        self.K, self.D = gain("stiffness", stiffness, 1)[0], gain("damping", damping, 1)[0]
+        self.Dn = self.D if normal_damping is None else gain("normal_damping", normal_damping, 1)[0]
+        self.joint_damping = gain("joint_damping", joint_damping, model.nv)
+        self.P = np.eye(3) - np.outer(self.n, self.n)
+
+    def __call__(self, t, q, v):
+        x = frame_pose(self.model, q, self.body)[:3, 3]
+        J = jacobian(self.model, q, self.body, "local_world_aligned")[:3]
+        xdot = J @ v
+        x_d = np.asarray(self.path(t), dtype=float)
+        F = self.P @ (self.K * (x_d - x) - self.D * xdot) - self.force * self.n - self.Dn * self.n * (self.n @ xdot)
+        return J.T @ F - self.joint_damping * v + gravity(self.model, q)
