@@ -37,7 +37,7 @@ _LAZY = {
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
               "rollout": "simulation", "Rollouts": "simulation", "simulation": None,
               "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
-              "contact": None, "Contacts": "contact", "inertia": None}
+              "contact": None, "Contacts": "contact", "inertia": None, "actuators": None}
 
 
 def __getattr__(name):

@@ -1,0 +1,115 @@
+"""Actuators: geared DC motors driven by voltage.
+
+The course model of a voltage-controlled geared motor on joint ``k`` (gear ratio ``N``, motor
+angle ``N q``): the winding current ``i`` follows
+
+    L di/dt = V - R i - k_e N v                   (armature circuit, back-EMF of the rotor)
+
+and the joint receives ``tau = eta N k_t i`` (efficiency ``eta``) while the rotor adds its
+inertia and friction, reflected through the gear: ``N^2 J_m`` on the joint's armature,
+``N^2 B_m`` viscous and ``N F_c`` Coulomb friction. So that ``rnea``, ``aba``, ``crba``,
+``simulate`` and identification (armature and friction columns) all see the motors, the
+reflected terms go into the model: :meth:`DCMotor.plant` returns it; the electrical part is a
+controller with an internal state (the currents), :class:`VoltageDrive`, that
+:func:`robodyn.simulate` integrates with the robot:
+
+    motor = actuators.DCMotor(torque_constant=0.05, back_emf=0.05, resistance=1.0,
+                              inductance=1e-3, gear_ratio=50.0, rotor_inertia=1e-5)
+    plant = motor.plant(model)
+    drive = actuators.VoltageDrive(plant, motor, lambda t, q, v: 12.0 * np.ones(plant.nv))
+    traj = rd.simulate(plant, q0, v0, 1.0, 1e-3, controller=drive, integrator="Radau")
+    traj.controller_state                             # the currents (A)
+
+The electrical time constant ``L / R`` is usually far shorter than the mechanical one: use an
+implicit integrator (``"Radau"``) or a step well below ``L / R``. The supply saturates the
+command at ``+-max_voltage``. Reference: Spong, Hutchinson & Vidyasagar (2006), section 6.1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .control.controllers import Controller
+
+FIELDS = ("torque_constant", "back_emf", "resistance", "inductance", "gear_ratio", "efficiency", "rotor_inertia",
+          "viscous", "coulomb", "max_voltage")
+
+
+@dataclass(frozen=True)
+class DCMotor:
+    """A geared DC motor per joint (numbers, or one per dof): ``torque_constant`` ``k_t``
+    (N m/A), ``back_emf`` ``k_e`` (V s/rad), ``resistance`` ``R`` (ohm), ``inductance`` ``L``
+    (H), ``gear_ratio`` ``N``, ``efficiency`` ``eta`` (0, 1], ``rotor_inertia`` ``J_m``
+    (kg m^2), ``viscous`` ``B_m`` (N m s/rad) and ``coulomb`` ``F_c`` (N m) on the rotor side,
+    ``max_voltage`` of the supply (V)."""
+
+    torque_constant: float
+    back_emf: float
+    resistance: float
+    inductance: float
+    gear_ratio: float = 1.0
+    efficiency: float = 1.0
+    rotor_inertia: float = 0.0
+    viscous: float = 0.0
+    coulomb: float = 0.0
+    max_voltage: float = np.inf
+
+    def arrays(self, nv: int) -> dict:
+        """Every field as an (nv,) array, checked."""
+        out = {}
+        for name in FIELDS:
+            try:
+                x = np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (nv,)).copy()
+            except (TypeError, ValueError):
+                raise ValueError(f"DCMotor.{name}: expected a number or {nv} numbers") from None
+            positive = name in ("torque_constant", "back_emf", "resistance", "inductance", "gear_ratio",
+                                "efficiency", "max_voltage")
+            if np.any(np.isnan(x)) or (np.any(x <= 0) if positive else np.any(x < 0)) or (
+                    name != "max_voltage" and not np.all(np.isfinite(x))):
+                raise ValueError(f"DCMotor.{name}: expected {'> 0' if positive else '>= 0'} finite values, "
+                                 f"got {x.tolist()}")
+            out[name] = x
+        if np.any(out["efficiency"] > 1):
+            raise ValueError(f"DCMotor.efficiency: expected values in (0, 1], got {out['efficiency'].tolist()}")
+        return out
+
+    def plant(self, model):
+        """``model`` with the rotors reflected through the gears: armature ``+ N^2 J_m``,
+        damping ``+ N^2 B_m``, Coulomb friction ``+ N F_c``."""
+        m = self.arrays(model.nv)
+        N = m["gear_ratio"]
+        return model.replace(armature=model.armature + N * N * m["rotor_inertia"],
+                             damping=model.damping + N * N * m["viscous"],
+                             coulomb=model.coulomb + N * m["coulomb"])
+
+
+class VoltageDrive(Controller):
+    """The motors' electrical dynamics driven by a voltage command (module docstring).
+
+    ``voltage``: a callable ``(t, q, v) -> V`` (nv,) (a voltage-level controller, clipped to
+    ``+-max_voltage``). The state is the winding currents (``state0``: ``current0``, default 0);
+    the joint torque is ``eta N k_t i``.
+    """
+
+    def __init__(self, model, motor: DCMotor, voltage, current0=None):
+        super().__init__(model)
+        if not callable(voltage):
+            raise ValueError(f"voltage: expected a callable (t, q, v) -> (nv,), got {type(voltage).__name__}")
+        self.motor, self.voltage = motor, voltage
+        self.m = motor.arrays(model.nv)
+        self.state0 = np.zeros(model.nv) if current0 is None else np.array(current0, dtype=float).reshape(model.nv)
+
+    def command(self, t, q, v) -> np.ndarray:
+        """The supply voltage ``V`` (nv,) after saturation."""
+        V = np.asarray(self.voltage(t, q, v), dtype=float)
+        return np.clip(V, -self.m["max_voltage"], self.m["max_voltage"])
+
+    def torque(self, t, q, v, z):
+        m = self.m
+        return m["efficiency"] * m["gear_ratio"] * m["torque_constant"] * z
+
+    def state_rate(self, t, q, v, z):
+        m = self.m
+        return (self.command(t, q, v) - m["resistance"] * z - m["back_emf"] * m["gear_ratio"] * v) / m["inductance"]

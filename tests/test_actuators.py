@@ -1,0 +1,95 @@
+"""Geared DC motors driven by voltage (robodyn.actuators): the locked rotor's current and
+torque V / R and k_t V / R with the electrical time constant L / R, the no-load speed
+V / (k_e N) with the mechanical time constant J R / (k_t k_e N^2), both within 1 %; the
+energy balance (electrical power in = copper loss + magnetic energy + kinetic energy +
+friction) to 1e-6; the reflected rotor inertia and friction in the model; bad input."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import robodyn as rd
+from robodyn import actuators
+
+from helpers import assert_rel
+
+
+def rotor(inertia=0.02, **joint):
+    """One revolute joint about z (gravity does not act on it) carrying a disk."""
+    b = rd.ModelBuilder("rotor", gravity=(0.0, 0.0, -9.81))
+    b.add_link("disk", mass=1.0, inertia=np.diag([0.01, 0.01, inertia]))
+    b.add_joint("shaft", "revolute", "world", "disk", axis=(0, 0, 1), **joint)
+    return b.build()
+
+
+MOTOR = dict(torque_constant=0.05, back_emf=0.05, resistance=2.0, inductance=2e-3, gear_ratio=10.0)
+
+
+def test_locked_rotor():
+    """A rotor too heavy to move (armature 1e9): i(t) = V/R (1 - exp(-t R/L))."""
+    motor = actuators.DCMotor(**MOTOR)
+    plant = motor.plant(rotor().replace(armature=np.array([1e9])))
+    V = 12.0
+    drive = actuators.VoltageDrive(plant, motor, lambda t, q, v: np.array([V]))
+    tau_e = MOTOR["inductance"] / MOTOR["resistance"]
+    run = rd.simulate(plant, np.zeros(1), np.zeros(1), 10 * tau_e, tau_e / 100, controller=drive, integrator="rk4")
+    i = run.controller_state[:, 0]
+    assert_rel(i[100], V / MOTOR["resistance"] * (1 - np.exp(-1.0)), 0.01 * V / MOTOR["resistance"])
+    assert i[-1] == pytest.approx(V / MOTOR["resistance"], rel=1e-3)
+    assert run.tau[-1, 0] == pytest.approx(MOTOR["torque_constant"] * MOTOR["gear_ratio"] * V / MOTOR["resistance"],
+                                           rel=1e-3)
+
+
+def test_no_load_speed_and_mechanical_time_constant():
+    motor = actuators.DCMotor(**{**MOTOR, "inductance": 1e-5}, rotor_inertia=1e-4)
+    plant = motor.plant(rotor())
+    V, N, k = 6.0, MOTOR["gear_ratio"], MOTOR["torque_constant"]
+    drive = actuators.VoltageDrive(plant, motor, lambda t, q, v: np.array([V]))
+    J = 0.02 + N * N * 1e-4                          # the disk and the reflected rotor
+    tau_m = J * MOTOR["resistance"] / (k * MOTOR["back_emf"] * N * N)
+    run = rd.simulate(plant, np.zeros(1), np.zeros(1), 8 * tau_m, tau_m / 200, controller=drive, integrator="Radau",
+                      rtol=1e-10, atol=1e-12)
+    speed = V / (MOTOR["back_emf"] * N)
+    assert run.v[-1, 0] == pytest.approx(speed * (1 - np.exp(-8.0)), rel=1e-3)
+    assert run.v[200, 0] == pytest.approx(speed * (1 - np.exp(-1.0)), rel=0.01)
+
+
+def test_energy_balance():
+    """Over a run with friction, saturation and a varying command: the integral of V i equals
+    the copper loss, the magnetic energy, the kinetic energy and the friction losses (joint
+    and rotor) to 1e-6."""
+    from scipy.integrate import simpson
+
+    L = 0.05  # an electrical time constant of 25 ms: the samples resolve it
+    motor = actuators.DCMotor(**{**MOTOR, "inductance": L}, rotor_inertia=2e-4, viscous=1e-4, max_voltage=9.0)
+    plant = motor.plant(rotor(damping=0.01))
+    drive = actuators.VoltageDrive(plant, motor, lambda t, q, v: np.array([12.0 * np.sin(3.0 * t)]))
+    run = rd.simulate(plant, np.zeros(1), np.zeros(1), 1.0, 5e-4, controller=drive, integrator="Radau",
+                      rtol=1e-11, atol=1e-13)
+    i, v = run.controller_state[:, 0], run.v[:, 0]
+    V = np.clip(12.0 * np.sin(3.0 * run.t), -9.0, 9.0)
+    saturated = np.abs(12.0 * np.sin(3.0 * run.t)) > 9.0
+    integral = lambda y: float(simpson(y, x=run.t))  # noqa: E731
+    energy_in = integral(V * i)
+    copper = integral(MOTOR["resistance"] * i * i)
+    magnetic = 0.5 * L * (i[-1] ** 2 - i[0] ** 2)
+    friction = integral(plant.damping[0] * v * v)                  # joint and reflected rotor viscous
+    kinetic = run.kinetic[-1] - run.kinetic[0]
+    assert abs(energy_in - (copper + magnetic + friction + kinetic)) < 1e-6 * energy_in
+    assert saturated.any() and kinetic > 0 and friction > 0
+
+
+def test_reflected_terms_and_bad_input():
+    motor = actuators.DCMotor(**MOTOR, rotor_inertia=1e-4, viscous=2e-4, coulomb=0.01)
+    plant = motor.plant(rotor(damping=0.1))
+    assert plant.armature[0] == pytest.approx(100 * 1e-4)
+    assert plant.damping[0] == pytest.approx(0.1 + 100 * 2e-4)
+    assert plant.coulomb[0] == pytest.approx(10 * 0.01)
+    assert rd.crba(plant, np.zeros(1))[0, 0] == pytest.approx(0.02 + 0.01)
+    with pytest.raises(ValueError, match=r"DCMotor.resistance: expected > 0"):
+        actuators.DCMotor(**{**MOTOR, "resistance": 0.0}).plant(rotor())
+    with pytest.raises(ValueError, match=r"DCMotor.efficiency: expected values in \(0, 1\]"):
+        actuators.DCMotor(**MOTOR, efficiency=1.5).plant(rotor())
+    with pytest.raises(ValueError, match="voltage: expected a callable"):
+        actuators.VoltageDrive(rotor(), actuators.DCMotor(**MOTOR), 12.0)
