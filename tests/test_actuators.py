@@ -93,3 +93,36 @@ def test_reflected_terms_and_bad_input():
         actuators.DCMotor(**MOTOR, efficiency=1.5).plant(rotor())
     with pytest.raises(ValueError, match="voltage: expected a callable"):
         actuators.VoltageDrive(rotor(), actuators.DCMotor(**MOTOR), 12.0)
+
+
+def test_flexible_joints_conserve_energy_and_approach_the_rigid_robot():
+    """Without input or damping the links, motors and springs conserve their energy; with
+    Tomei's motor PD the links settle at the set point; as K grows the motion approaches the
+    rigid robot's (with the motors' inertia as armature), the error shrinking like 1 / K."""
+    model = rd.models.load("double_pendulum")
+    q0, B = np.array([0.6, -0.3]), np.array([0.05, 0.05])
+    free = actuators.FlexibleJoints(model, 200.0, B, theta0=q0)
+    run = rd.simulate(model, q0, np.zeros(2), 1.0, 1e-3, controller=free, integrator="rk4")
+    total = run.energy + np.array([free.energy(q, v, z) for q, v, z in zip(run.q, run.v, run.controller_state)])
+    assert np.ptp(total) < 1e-8 * np.abs(total).max()
+    assert np.abs(run.controller_state[:, 0] - run.q[:, 0]).max() > 1e-3  # the springs do stretch
+    # regulation: Tomei's PD on the motors brings the links to q_d (slowly: the links are damped
+    # through the springs only)
+    q_d = np.array([0.3, 0.2])
+    law = actuators.motor_pd_gravity(model, q_d, 500.0, 500.0, 20.0)
+    held = actuators.FlexibleJoints(model, 500.0, B, law, damping=3.0, theta0=q0)
+    run = rd.simulate(model, q0, np.zeros(2), 8.0, 2e-3, controller=held, integrator="rk4")
+    error = np.abs(run.q - q_d).max(axis=1)
+    assert error[-1] < 2e-3 and error[-1] < 0.05 * error[500]
+    # the rigid limit, from the consistent start (the springs already carry the motors'
+    # share of the initial acceleration: theta - q = -B a0 / K)
+    Bm = 1e-3
+    stiff = model.replace(armature=np.full(2, Bm))
+    rigid = rd.simulate(stiff, q0, np.zeros(2), 0.2, 1e-4, integrator="rk4")
+    a0 = rd.aba(stiff, q0, np.zeros(2), np.zeros(2))
+    errors = []
+    for K in (1e3, 4e3):
+        flexible = actuators.FlexibleJoints(model, K, Bm, theta0=q0 - Bm * a0 / K)
+        run = rd.simulate(model, q0, np.zeros(2), 0.2, 1e-4, controller=flexible, integrator="rk4")
+        errors.append(np.abs(run.q - rigid.q).max())
+    assert 3.6 < errors[0] / errors[1] < 4.4, errors  # K four times stiffer: four times closer

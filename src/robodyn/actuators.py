@@ -113,3 +113,68 @@ class VoltageDrive(Controller):
     def state_rate(self, t, q, v, z):
         m = self.m
         return (self.command(t, q, v) - m["resistance"] * z - m["back_emf"] * m["gear_ratio"] * v) / m["inductance"]
+
+
+class FlexibleJoints(Controller):
+    """Elastic joints (Spong 1987): each joint's motor, of inertia ``B`` (reflected), drives
+    its link through a spring of stiffness ``K`` (and damping ``D``):
+
+        M(q) a + C(q, v) v + g(q) = K (theta - q) + D (theta' - v)      (the links: the plant)
+        B theta'' + K (theta - q) + D (theta' - v) = u                   (the motors: the state)
+
+    The motor angles and rates ``z = [theta, theta']`` are this controller's state, which
+    :func:`robodyn.simulate` integrates with the robot; the torque it applies to the links is
+    the spring's. ``u = motor_law(t, q, v, theta, theta')`` is the motor torque (nv,), e.g.
+    :func:`motor_pd_gravity`. Large ``K`` makes the system stiff: use an implicit integrator
+    (``"Radau"``) or a step well below ``sqrt(B / K)``. Reference: M. W. Spong, "Modeling and
+    control of elastic joint robots", J. Dyn. Sys., Meas., Control 109 (1987); Spong,
+    Hutchinson & Vidyasagar (2006), section 8.x.
+    """
+
+    def __init__(self, model, stiffness, motor_inertia, motor_law=None, *, damping=0.0, theta0=None):
+        super().__init__(model)
+        nv = model.nv
+        self.K = np.broadcast_to(np.asarray(stiffness, dtype=float), (nv,)).copy()
+        self.B = np.broadcast_to(np.asarray(motor_inertia, dtype=float), (nv,)).copy()
+        self.D = np.broadcast_to(np.asarray(damping, dtype=float), (nv,)).copy()
+        for name, x, strict in (("stiffness", self.K, True), ("motor_inertia", self.B, True), ("damping", self.D, False)):
+            if not np.all(np.isfinite(x)) or (np.any(x <= 0) if strict else np.any(x < 0)):
+                raise ValueError(f"{name}: expected finite values {'> 0' if strict else '>= 0'}, got {x.tolist()}")
+        if motor_law is not None and not callable(motor_law):
+            raise ValueError(f"motor_law: expected a callable (t, q, v, theta, theta_dot) -> u, got {motor_law!r}")
+        self.motor_law = motor_law
+        theta = np.zeros(nv) if theta0 is None else np.array(theta0, dtype=float).reshape(nv)
+        self.state0 = np.concatenate([theta, np.zeros(nv)])
+
+    def spring(self, q, v, z) -> np.ndarray:
+        """The joint torque the motors apply to the links, ``K (theta - q) + D (theta' - v)``."""
+        n = self.model.nv
+        return self.K * (z[:n] - q) + self.D * (z[n:] - v)
+
+    def torque(self, t, q, v, z):
+        return self.spring(q, v, z)
+
+    def state_rate(self, t, q, v, z):
+        n = self.model.nv
+        u = np.zeros(n) if self.motor_law is None else np.asarray(self.motor_law(t, q, v, z[:n], z[n:]), dtype=float)
+        return np.concatenate([z[n:], (u - self.spring(q, v, z)) / self.B])
+
+    def energy(self, q, v, z) -> float:
+        """The motors' kinetic energy and the springs' potential energy (add the links' energy
+        for the whole system's)."""
+        n = self.model.nv
+        return float(0.5 * self.B @ (z[n:] ** 2) + 0.5 * self.K @ ((z[:n] - q) ** 2))
+
+
+def motor_pd_gravity(model, q_desired, stiffness, kp, kd):
+    """Tomei's regulator for elastic joints (1991): ``u = Kp (theta_d - theta) - Kd theta' +
+    g(q_d)`` with the motor set point ``theta_d = q_d + K^-1 g(q_d)`` (the spring then holds
+    the links at ``q_d`` against gravity); globally asymptotically stable for ``Kp`` large
+    enough. A motor law for :class:`FlexibleJoints`."""
+    from .algorithms.terms import gravity
+
+    q_d = np.asarray(q_desired, dtype=float)
+    g_d = gravity(model, q_d)
+    theta_d = q_d + g_d / np.asarray(stiffness, dtype=float)
+    kp, kd = np.asarray(kp, dtype=float), np.asarray(kd, dtype=float)
+    return lambda t, q, v, theta, theta_dot: kp * (theta_d - theta) - kd * theta_dot + g_d
