@@ -100,3 +100,24 @@ def test_hybrid_control_holds_a_force_on_a_wall_while_sliding():
         control.HybridForcePosition(model, "link7", [1.0, 1.0, 0.0], 10.0, path, stiffness=1.0, damping=1.0)
     with pytest.raises(ValueError, match="force: expected a number > 0"):
         control.HybridForcePosition(model, "link7", n, -1.0, path, stiffness=1.0, damping=1.0)
+
+
+def test_operational_space_error_dynamics_and_null_space():
+    """With an exact model the task error of operational-space control obeys e'' + Kd e' +
+    Kp e = 0 (critically damped here: e(t) = e0 (1 + w t) exp(-w t)), and two postures in the
+    null space leave the task motion the same."""
+    model = rd.models.load("panda").rigid()
+    x0 = rd.frame_pose(model, Q0, "link7")[:3, 3]
+    e0 = np.array([0.05, -0.03, 0.04])
+    w = 8.0
+    runs = []
+    for posture in (Q0, Q0 + 0.3):
+        ctrl = control.OperationalSpace(model, "link7", x0 + e0, w * w, 2 * w, posture=posture, posture_kp=20.0,
+                                        posture_kd=5.0)
+        run = rd.simulate(model, Q0, np.zeros(7), 0.6, 1e-3, controller=ctrl, integrator="rk4")
+        x = np.array([ctrl.position(q) for q in run.q])
+        runs.append((run, x))
+        expected = e0 * ((1 + w * run.t) * np.exp(-w * run.t))[:, None]
+        assert_rel(x0 + e0 - x, expected, 1e-6)
+    assert_rel(runs[0][1], runs[1][1], 1e-6)
+    assert np.abs(runs[0][0].q[-1] - runs[1][0].q[-1]).max() > 1e-2  # the postures did differ

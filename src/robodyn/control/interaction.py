@@ -34,6 +34,7 @@ import numpy as np
 
 from ..algorithms.jacobian import jacobian
 from ..algorithms.kinematics import frame_pose
+from ..algorithms.task_space import task_rows, task_space_dynamics
 from ..algorithms.terms import gravity
 from .controllers import Controller, gain
 
@@ -143,3 +144,55 @@ class HybridForcePosition(Controller):
         x_d = np.asarray(self.path(t), dtype=float)
         F = self.P @ (self.K * (x_d - x) - self.D * xdot) - self.force * self.n - self.Dn * self.n * (self.n @ xdot)
         return J.T @ F - self.joint_damping * v + gravity(self.model, q)
+
+
+class OperationalSpace(Controller):
+    """Khatib's operational-space control of a frame's position with a posture in the null
+    space (Khatib 1987; Siciliano et al. (2009), section 8.6.2):
+
+        F = Lambda (x_d'' + Kd (x_d' - x') + Kp (x_d - x)) + mu + p
+        tau = J^T F + (1 - J^T Jbar^T) (Kp_n (q_p - q) - Kd_n v + g(q))
+
+    with ``Lambda, mu, p, Jbar`` of :func:`robodyn.task_space_dynamics` (rows of the frame's
+    origin velocity in world axes: ``rows``, default the three linear ones). With an exact
+    model the task error obeys ``e'' + Kd e' + Kp e = 0`` whatever the posture does, and the
+    posture torques never disturb the task.
+
+    Args:
+        body: the link or frame. target: ``t -> (x_d, x_d', x_d'')`` for the selected rows, or
+            a fixed (m,) position. kp, kd: task gains (numbers or (m,)). posture: (nv,) and
+            posture_kp, posture_kd: the null-space PD.
+    """
+
+    def __init__(self, model, body: str, target, kp, kd, *, posture=None, posture_kp=10.0, posture_kd=2.0,
+                 rows="linear"):
+        super().__init__(model)
+        model.frame_index(body)
+        self.body, self.rows = body, rows
+        self.index = task_rows(rows)[0]
+        m = self.index.size
+        if not callable(target):
+            fixed = np.array(target, dtype=float)
+            if fixed.shape != (m,) or not np.all(np.isfinite(fixed)):
+                raise ValueError(f"target: expected {m} finite numbers or a callable t -> (x, x', x''), "
+                                 f"got shape {fixed.shape}")
+            target = lambda t: (fixed, np.zeros(m), np.zeros(m))  # noqa: E731
+        self.target = target
+        self.kp, self.kd = gain("kp", kp, m), gain("kd", kd, m)
+        self.posture = np.zeros(model.nv) if posture is None else np.array(posture, dtype=float).reshape(model.nv)
+        self.posture_kp, self.posture_kd = gain("posture_kp", posture_kp, model.nv), gain("posture_kd", posture_kd,
+                                                                                          model.nv)
+
+    def position(self, q) -> np.ndarray:
+        """The selected rows of the frame's origin (world): position rows only (0-2)."""
+        return frame_pose(self.model, q, self.body)[:3, 3][self.index]
+
+    def __call__(self, t, q, v):
+        if np.any(self.index > 2):
+            raise ValueError("OperationalSpace: position rows (0-2) only")
+        T = task_space_dynamics(self.model, q, v, self.body, "local_world_aligned", self.index)
+        x_d, xd_d, xdd_d = (np.asarray(y, dtype=float) for y in self.target(t))
+        e, ed = x_d - self.position(q), xd_d - T.J @ v
+        F = T.Lambda @ (xdd_d + self.kd * ed + self.kp * e) + T.mu + T.p
+        tau0 = self.posture_kp * (self.posture - q) - self.posture_kd * v + gravity(self.model, q)
+        return T.J.T @ F + tau0 - T.J.T @ (T.Jbar.T @ tau0)
