@@ -121,3 +121,19 @@ def test_operational_space_error_dynamics_and_null_space():
         assert_rel(x0 + e0 - x, expected, 1e-6)
     assert_rel(runs[0][1], runs[1][1], 1e-6)
     assert np.abs(runs[0][0].q[-1] - runs[1][0].q[-1]).max() > 1e-2  # the postures did differ
+
+
+def test_impedance_against_a_wall_presses_with_its_spring():
+    """The hand held 2 cm behind a rigid wall by a Cartesian spring K rests pressing K * 2 cm
+    (the example's first scene), within 1 %."""
+    from robodyn.contact import Contacts, Plane, Sphere
+
+    model = rd.models.load("panda").rigid()
+    q0 = np.array([0.0, 0.3, 0.0, -1.8, 0.0, 2.1, 0.8])
+    x0 = rd.frame_pose(model, q0, "link7")[:3, 3]
+    wall = Plane(normal=[-1.0, 0.0, 0.0], height=-(x0[0] + 0.022), friction=0.2)
+    contacts = Contacts([Sphere("link7", 0.02)], surfaces=[wall])
+    ctrl = control.CartesianImpedance(model, "link7", x0 + [0.022, 0.0, 0.0], stiffness=800.0, damping=80.0,
+                                      joint_damping=2.0)
+    run = rd.simulate(model, q0, np.zeros(7), 2.0, 1e-3, controller=ctrl, contacts=contacts)
+    assert run.normal_force[-1, 0] == pytest.approx(800.0 * 0.02, rel=0.01)
