@@ -137,3 +137,22 @@ def test_impedance_against_a_wall_presses_with_its_spring():
                                       joint_damping=2.0)
     run = rd.simulate(model, q0, np.zeros(7), 2.0, 1e-3, controller=ctrl, contacts=contacts)
     assert run.normal_force[-1, 0] == pytest.approx(800.0 * 0.02, rel=0.01)
+
+
+def test_admittance_yields_as_its_virtual_spring():
+    """A constant force pushing the hand: the admittance model moves the hand to rest + f / K_a
+    (within 1 %), the inner loop tracking the virtual motion; the virtual state is integrated
+    with the robot."""
+    model = rd.models.load("panda").rigid()
+    x0 = rd.frame_pose(model, Q0, "link7")[:3, 3]
+    f = np.array([6.0, -3.0, 4.0])
+    wrench = np.zeros((model.nbodies, 6))
+    wrench[model.frame_index("link7")[0], :3] = f
+    ctrl = control.Admittance(model, "link7", x0, lambda t, q, v: f, mass=2.0, damping=60.0, stiffness=300.0,
+                              kp=400.0, kd=40.0, posture=Q0, posture_kp=20.0, posture_kd=5.0)
+    run = rd.simulate(model, Q0, np.zeros(7), 2.0, 1e-3, controller=ctrl, f_ext=wrench, frame="local_world_aligned")
+    x = rd.frame_pose(model, run.q[-1], "link7")[:3, 3]
+    assert_rel(x - x0, f / 300.0, 0.01 * np.abs(f / 300.0).max())
+    assert_rel(run.controller_state[-1, :3], x, 1e-4)  # the hand is where the virtual mass is
+    with pytest.raises(ValueError, match="force: expected a callable"):
+        control.Admittance(model, "link7", x0, f, mass=1.0, damping=1.0, stiffness=1.0, kp=1.0, kd=1.0)

@@ -9,9 +9,9 @@
 
 from .controllers import (AdaptiveSlotineLi, ComputedTorque, Controller, JointPD, PDGravity, PIDGravity, SlotineLi,
                           TaskSpacePD)
-from .interaction import CartesianImpedance, HybridForcePosition, OperationalSpace, rotation_vector
+from .interaction import Admittance, CartesianImpedance, HybridForcePosition, OperationalSpace, rotation_vector
 from .references import PointToPoint, Sampled, cubic, quintic
 from .whole_body import WholeBodyID, whole_body_inverse_dynamics
 
-__all__ = ["Controller", "CartesianImpedance", "HybridForcePosition", "OperationalSpace", "rotation_vector", "WholeBodyID", "whole_body_inverse_dynamics", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
+__all__ = ["Controller", "CartesianImpedance", "HybridForcePosition", "OperationalSpace", "Admittance", "rotation_vector", "WholeBodyID", "whole_body_inverse_dynamics", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
            "cubic", "quintic", "AdaptiveSlotineLi", "JointPD"]

@@ -188,11 +188,53 @@ class OperationalSpace(Controller):
         return frame_pose(self.model, q, self.body)[:3, 3][self.index]
 
     def __call__(self, t, q, v):
+        return self.law(q, v, *self.target(t))
+
+    def law(self, q, v, x_d, xd_d, xdd_d, force=0.0):
+        """The joint torques for the task reference ``(x_d, x_d', x_d'')`` (module docstring),
+        compensating a known external force ``force`` (m,) on the frame."""
         if np.any(self.index > 2):
-            raise ValueError("OperationalSpace: position rows (0-2) only")
+            raise ValueError(f"{type(self).__name__}: position rows (0-2) only")
         T = task_space_dynamics(self.model, q, v, self.body, "local_world_aligned", self.index)
-        x_d, xd_d, xdd_d = (np.asarray(y, dtype=float) for y in self.target(t))
+        x_d, xd_d, xdd_d = (np.asarray(y, dtype=float) for y in (x_d, xd_d, xdd_d))
         e, ed = x_d - self.position(q), xd_d - T.J @ v
-        F = T.Lambda @ (xdd_d + self.kd * ed + self.kp * e) + T.mu + T.p
+        F = T.Lambda @ (xdd_d + self.kd * ed + self.kp * e) + T.mu + T.p - force
         tau0 = self.posture_kp * (self.posture - q) - self.posture_kd * v + gravity(self.model, q)
         return T.J.T @ F + tau0 - T.J.T @ (T.Jbar.T @ tau0)
+
+
+class Admittance(OperationalSpace):
+    """Admittance control (Siciliano et al. (2009), section 9.4): a measured external force
+    ``f`` on the frame drives a virtual mass-spring-damper about ``rest``,
+
+        M_a x_a'' + D_a x_a' + K_a (x_a - rest) = f,
+
+    whose position ``x_a`` the frame tracks with the stiff inner loop of
+    :class:`OperationalSpace` (the force compensated). At rest under a constant force the frame
+    sits at ``rest + f / K_a``. The virtual state ``[x_a, x_a']`` is the controller's state.
+    ``force``: a callable ``(t, q, v) -> f`` (m,), the force sensor's reading.
+    """
+
+    def __init__(self, model, body: str, rest, force, *, mass, damping, stiffness, kp, kd, **options):
+        super().__init__(model, body, rest, kp, kd, **options)
+        if not callable(force):
+            raise ValueError(f"force: expected a callable (t, q, v) -> f, got {type(force).__name__}")
+        m = self.index.size
+        self.rest = np.array(rest, dtype=float).reshape(m)
+        self.force = force
+        self.Ma, self.Da, self.Ka = gain("mass", mass, m), gain("damping", damping, m), gain("stiffness", stiffness, m)
+        self.state0 = np.concatenate([self.rest, np.zeros(m)])
+
+    def _accel(self, t, q, v, z):
+        m = self.index.size
+        f = np.asarray(self.force(t, q, v), dtype=float)
+        return f, (f - self.Da * z[m:] - self.Ka * (z[:m] - self.rest)) / self.Ma
+
+    def torque(self, t, q, v, z):
+        m = self.index.size
+        f, acc = self._accel(t, q, v, z)
+        return self.law(q, v, z[:m], z[m:], acc, force=f)
+
+    def state_rate(self, t, q, v, z):
+        m = self.index.size
+        return np.concatenate([z[m:], self._accel(t, q, v, z)[1]])
