@@ -126,3 +126,21 @@ def test_flexible_joints_conserve_energy_and_approach_the_rigid_robot():
         run = rd.simulate(model, q0, np.zeros(2), 0.2, 1e-4, controller=flexible, integrator="rk4")
         errors.append(np.abs(run.q - rigid.q).max())
     assert 3.6 < errors[0] / errors[1] < 4.4, errors  # K four times stiffer: four times closer
+
+
+def test_position_servo():
+    """A motor-side PD in volts on a horizontal rotor reaches its set point; on a pendulum
+    under gravity it settles where the motor's static torque k_t N V / R holds the load."""
+    motor = actuators.DCMotor(**MOTOR, rotor_inertia=1e-4)
+    plant = motor.plant(rotor())
+    drive = actuators.VoltageDrive(plant, motor, actuators.position_servo([1.0], 40.0, 4.0))
+    run = rd.simulate(plant, np.zeros(1), np.zeros(1), 3.0, 1e-3, controller=drive, integrator="Radau")
+    assert run.q[-1, 0] == pytest.approx(1.0, abs=1e-4)
+    pendulum = motor.plant(rd.models.load("pendulum"))
+    kp = 400.0
+    drive = actuators.VoltageDrive(pendulum, motor, actuators.position_servo([0.5], kp, 60.0))
+    run = rd.simulate(pendulum, np.array([0.5]), np.zeros(1), 4.0, 1e-3, controller=drive, integrator="Radau")
+    q = run.q[-1, 0]
+    held = MOTOR["torque_constant"] * MOTOR["gear_ratio"] * kp * (0.5 - q) / MOTOR["resistance"]
+    assert held == pytest.approx(rd.gravity(pendulum, run.q[-1])[0], rel=1e-6)
+    assert 0.01 < q - 0.5 < 0.1  # the offset a proportional servo leaves under load

@@ -178,3 +178,12 @@ def motor_pd_gravity(model, q_desired, stiffness, kp, kd):
     theta_d = q_d + g_d / np.asarray(stiffness, dtype=float)
     kp, kd = np.asarray(kp, dtype=float), np.asarray(kd, dtype=float)
     return lambda t, q, v, theta, theta_dot: kp * (theta_d - theta) - kd * theta_dot + g_d
+
+
+def position_servo(q_desired, kp, kd):
+    """A voltage law for :class:`VoltageDrive`: a PD on the motor side, ``V = kp (q_d - q) -
+    kd v`` (V/rad, V s/rad), the hobby servo's loop. With gravity the joint settles where the
+    motor torque ``eta N k_t V / R`` holds the load: an offset that shrinks as ``kp`` grows."""
+    q_d = np.asarray(q_desired, dtype=float)
+    kp, kd = np.asarray(kp, dtype=float), np.asarray(kd, dtype=float)
+    return lambda t, q, v: kp * (q_d - q) - kd * v
