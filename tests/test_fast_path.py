@@ -1,8 +1,8 @@
-"""The single-state fast paths of rnea, aba, crba and coriolis_matrix (compiled for contiguous
-float64 vectors only) and the general path they fall back to: every other kind of input gives
-the same result (float32 input is converted to float64, and so is the result), results written
-into ``out`` equal the returned ones, and the workspaces carved from one buffer never overrun
-it."""
+"""The single-state fast paths of rnea, aba, crba, coriolis_matrix, inverse_mass_matrix and
+hybrid_dynamics (compiled for contiguous float64 vectors only) and the general path they fall
+back to: every other kind of input gives the same result (float32 input is converted to
+float64, and so is the result), results written into ``out`` equal the returned ones, and the
+workspaces carved from one buffer never overrun it."""
 
 from __future__ import annotations
 
@@ -34,10 +34,23 @@ def variants(x):
     return {"list": x.tolist(), "read-only": ro, "strided": strided, "batch of one": x[None]}
 
 
+def _hybrid(m, q, v, a, **kw):
+    """hybrid_dynamics, the accelerations of the second half of the dofs known: (a, tau) side by side."""
+    known = np.arange(m.nv) >= m.nv // 2
+    return np.concatenate(rd.hybrid_dynamics(m, q, v, a, a, known, **kw), axis=-1)
+
+
+# the fast paths taken when ``_inputs.vectors`` accepts every argument
+VECTOR_CALLS = {
+    "inverse_mass_matrix": lambda m, q, v, a, **kw: rd.inverse_mass_matrix(m, q, **kw),
+    "hybrid_dynamics": _hybrid,
+}
+
+
 @pytest.mark.parametrize("model", MODELS, ids=["panda", "floating tree"])
-@pytest.mark.parametrize("name", list(CALLS))
+@pytest.mark.parametrize("name", list(CALLS) + list(VECTOR_CALLS))
 def test_every_input_kind_gives_the_fast_result(model, name):
-    call = CALLS[name]
+    call = {**CALLS, **VECTOR_CALLS}[name]
     q, v, a = random_state(model, np.random.default_rng(7))
     expected = call(model, q, v, a)
     for kind, (qx, vx, ax) in zip(variants(q), zip(*(variants(x).values() for x in (q, v, a)))):

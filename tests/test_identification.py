@@ -5,7 +5,10 @@ noisy prediction on another trajectory, physically consistent export), and the C
 
 from __future__ import annotations
 
+import ast
+import dataclasses
 import functools
+import re
 
 import numpy as np
 import pytest
@@ -15,7 +18,9 @@ from robodyn import identification as ident
 from robodyn.cli import main
 from robodyn.identification.identify import METHODS
 from robodyn.identification.estimation import log_cholesky, theta_jacobian, theta_of_log_cholesky
+from robodyn.joints import NQ
 from robodyn.model import check_inertial_parameters
+from robodyn.random import random_model
 from helpers import PLANAR_2R, assert_rel, planar_2r, random_models, rng_for
 
 
@@ -86,13 +91,102 @@ def test_base_regressor_reproduces_rnea(model):
     theta = np.concatenate([model.inertial_parameters(), np.full(2 * model.nv, 0.3)])
     expected = rd.rnea(model.replace(damping=np.full(model.nv, 0.3), coulomb=np.full(model.nv, 0.3)), q, v, a)
     assert_rel(base.regressor(model, q, v, a) @ base.project(theta), expected, 1e-9)
-    completed = base.completion(base.project(theta), np.zeros(theta.shape))
+    prior = theta * rng_for(model.name, "prior").uniform(0.5, 1.5, theta.shape)
+    completed = base.completion(base.project(theta), prior)
     assert_rel(base.project(completed), base.project(theta), 1e-9)
+    # the nearest to the prior: the change lies in the row space of K (orthogonal to its null space)
+    change = completed - prior
+    assert_rel(np.linalg.pinv(base.K) @ (base.K @ change), change, 1e-9)
+
+
+def test_random_states_respect_joint_limits():
+    """1-dof joints with finite limits are drawn within them, also after a free joint; the
+    ones without limits (or with one only) stay in [-pi, pi]; the free joint's quaternion stays
+    of unit norm."""
+    model = random_model(5, seed=3, floating_base=True)
+    one_dof = [i for i in range(model.nbodies) if NQ[model.joint_type[i]] == 1]
+    lower, upper = np.full(model.nv, -np.inf), np.full(model.nv, np.inf)
+    limited, half, free = one_dof[:-2], one_dof[-2], one_dof[-1]
+    for k, i in enumerate(limited):
+        lower[model.idx_v[i]], upper[model.idx_v[i]] = -0.3 + 0.1 * k, 0.2 + 0.1 * k
+    lower[model.idx_v[half]] = 0.5
+    model = model.replace(lower=lower, upper=upper)
+    q, v, a = ident.base.random_states(model, 200, rng_for("random-states-limits"))
+    assert q.shape == (200, model.nq) and v.shape == a.shape == (200, model.nv)
+    for i in limited:
+        x, lo, hi = q[:, model.idx_q[i]], lower[model.idx_v[i]], upper[model.idx_v[i]]
+        assert np.all((lo <= x) & (x <= hi)) and x.max() - x.min() > 0.9 * (hi - lo), (i, x.min(), x.max())
+    for i in (half, free):
+        x = q[:, model.idx_q[i]]
+        assert np.all(np.abs(x) <= np.pi) and x.min() < -2.5 and x.max() > 2.5
+    assert_rel(np.linalg.norm(q[:, 3:7], axis=1), np.ones(200), 1e-12)
+
+
+def _coefficients(name: str, columns) -> np.ndarray:
+    """The row of K that a base parameter's name spells: ``head (+|-) [c*]column ...``."""
+    tokens = name.split(" ")
+    row = np.zeros(len(columns))
+    row[columns.index(tokens[0])] = 1.0
+    for sign, term in zip(tokens[1::2], tokens[2::2]):
+        c, _, column = term.rpartition("*")
+        row[columns.index(column)] = (-1.0 if sign == "-" else 1.0) * (float(c) if c else 1.0)
+    return row
+
+
+def test_base_parameter_names_spell_K():
+    """The names carry the signs and (6 significant digits of) the coefficients of K, a
+    coefficient of magnitude one without a factor."""
+    puma = ident.base_parameters(rd.models.load("puma560"))
+    np.testing.assert_allclose([_coefficients(n, puma.columns) for n in puma.names], puma.K, rtol=1e-5, atol=1e-12)
+    elbow = ident.base_parameters(rd.models.load("elbow_3r"))
+    assert {"Ixx2 - Iyy2 - 0.16*m3", "Ixz2 - 0.4*mz3", "Ixx3 - Iyy3"} <= set(elbow.names)
+    arm = ident.base_parameters(planar_2r(**{**PLANAR_2R, "l1": np.sqrt(2.0)}))  # Izz1 absorbs l1^2 m2 = 2 m2
+    assert arm.names[:3] == ("mx1 + 1.41421*m2", "my1", "Izz1 + 2*m2")
+
+
+def test_base_parameter_summary_gap_and_singular_values():
+    """The summary's lines; gap = sigma_r / sigma_{r+1} (inf at full column rank); the
+    singular values are those of the regressor with its nonzero columns scaled to unit norm
+    (squares summing to their number); the result is immutable."""
+    base = ident.base_parameters(planar_2r(**PLANAR_2R))
+    s = base.singular_values
+    assert s.shape == (20,) and np.all(np.diff(s) <= 0)
+    assert base.gap == s[5] / s[6]
+    # nonzero columns of the vertical 2R arm: mx1, my1, Izz1, m2, mx2, my2, Izz2
+    assert_rel(np.sum(s ** 2), 7.0, 1e-12)
+    assert base.summary().splitlines() == [
+        f"6 base parameters of 20 (relative tolerance 1e-08; singular values of the scaled regressor: "
+        f"sigma_6 = {s[5]:.3g}, sigma_7 = {s[6]:.3g}, gap {base.gap:.3g})",
+        "    1  mx1 + 0.8*m2", "    2  my1", "    3  Izz1 + 0.64*m2", "    4  mx2", "    5  my2", "    6  Izz2"]
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        base.rtol = 1e-6
+    body = ident.base_parameters(random_model(0, seed=1, floating_base=True))  # one free body: all 10 identifiable
+    s = body.singular_values
+    assert body.count == 10 and body.gap == np.inf and np.all(s > 0.1)
+    assert body.summary().splitlines()[0] == ("10 base parameters of 10 (relative tolerance 1e-08; singular values of "
+                                              f"the scaled regressor: sigma_10 = {s[9]:.3g}, full rank)")
 
 
 def test_base_parameter_errors():
-    with pytest.raises(ValueError, match="rtol"):
-        ident.base_parameters(rd.models.load("pendulum"), rtol=2.0)
+    pendulum = rd.models.load("pendulum")
+    for rtol in (2.0, 1.0, 0.0, -1e-8):
+        with pytest.raises(ValueError, match=rf"rtol: expected a value in \(0, 1\), got {rtol}"):
+            ident.base_parameters(pendulum, rtol=rtol)
+    with pytest.raises(TypeError):
+        ident.base_parameters(pendulum, True)  # the options are keywords only
+    fixed = rd.ModelBuilder("no-joints")
+    fixed.add_link("base", mass=1.0, inertia=np.eye(3))
+    with pytest.raises(ValueError, match="the model has no joints"):
+        ident.base_parameters(fixed.build())
+    # rtol inside a cluster of singular values: the rank and the columns kept in order disagree;
+    # the message shows the singular values around the rank (two on either side where there are)
+    for rtol in (0.9, 0.5):
+        with pytest.raises(ValueError, match=rf"singular values above rtol={rtol:g} but \d+ independent") as err:
+            ident.base_parameters(rd.models.load("puma560"), rtol=rtol)
+        msg = str(err.value)
+        rank = int(re.search(r"(\d+) singular values above", msg).group(1))
+        shown = ast.literal_eval(re.search(r"near the tolerance: (\[[^]]*\])", msg).group(1))
+        assert len(shown) == min(rank, 2) + 2 and shown == sorted(shown, reverse=True), msg
 
 
 # -- excitation -------------------------------------------------------------------------------
@@ -178,17 +272,36 @@ def _two_joint_columns(kinds=("q", "tau")):
 def test_log_errors(tmp_path):
     model = rd.models.load("planar_2r")
     good = [[0.01 * i, 0.1, 0.2, 1.0, 2.0] for i in range(5)]
-    with pytest.raises(ValueError, match=r"missing columns \['tau:joint2'\]"):
+    with pytest.raises(ValueError, match=r"missing columns \['tau:joint2'\] .*expected t, q:<coordinate>, tau:<dof> "):
         ident.read_log(_write(tmp_path / "a.csv", _two_joint_columns()[:-1], [r[:-1] for r in good]), model,
                        require_tau=True)
+    with pytest.raises(ValueError, match=r"missing columns \['q:joint2'\] .*; expected t, q:<coordinate> with "):
+        ident.read_log(_write(tmp_path / "a.csv", ["t", "q:joint1"], [r[:2] for r in good]), model)
+    with pytest.raises(ValueError, match=r"repeated column names \['q:joint1'\]$"):
+        ident.read_log(_write(tmp_path / "a.csv", _two_joint_columns() + ["q:joint1"], [r + [0] for r in good]), model)
+    (tmp_path / "binary.csv").write_bytes(b"t,q:joint1\n\xff\xfe\x00\n")
+    with pytest.raises(ValueError, match="binary.csv: not a CSV text file"):
+        ident.read_log(tmp_path / "binary.csv", model)
     rows = [r[:] for r in good]
     rows[1][2], rows[3][4] = "nan", ""
     with pytest.raises(ValueError, match=r"2 rows with missing or non-finite values at lines \[3, 5\]"):
         ident.read_log(_write(tmp_path / "b.csv", _two_joint_columns(), rows), model)
+    for n_bad, more in ((20, ""), (21, " ...")):  # the first 20 lines, "..." when there are more
+        rows = [[0.01 * i, 0.1, "nan" if i < n_bad else 0.2, 1.0, 2.0] for i in range(25)]
+        with pytest.raises(ValueError, match=re.escape(f"{n_bad} rows with missing or non-finite values at lines "
+                                                       f"{list(range(2, 22))}{more}; remove")):
+            ident.read_log(_write(tmp_path / "many.csv", _two_joint_columns(), rows), model)
     rows = [r[:] for r in good]
-    rows[3][0] = 0.01
-    with pytest.raises(ValueError, match=r"time not strictly increasing at line 5"):
+    rows[3][0], rows[4][0] = 0.015, 0.005  # the first of two steps back is reported
+    with pytest.raises(ValueError, match=r"time not strictly increasing at line 5 \(t = 0.015 after 0.02 on line 4\)"):
         ident.read_log(_write(tmp_path / "c.csv", _two_joint_columns(), rows), model)
+    with pytest.raises(ValueError, match="1 data rows, need at least 2"):
+        ident.read_log(_write(tmp_path / "one.csv", _two_joint_columns(), good[:1]), model)
+    (tmp_path / "empty.csv").write_text("")
+    with pytest.raises(ValueError, match="empty file, expected a header row"):
+        ident.read_log(tmp_path / "empty.csv", model)
+    with pytest.raises(TypeError):
+        ident.read_log(tmp_path / "b.csv", model, True)  # require_tau is a keyword only
     rows = [r[:] for r in good]
     rows[2][1] = "abc"
     with pytest.raises(ValueError, match=r"line 4, column 'q:joint1': not a number"):

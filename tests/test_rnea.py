@@ -3,6 +3,8 @@ linearity in the acceleration, the pendulum in closed form, batches and bad inpu
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -102,6 +104,25 @@ def test_batch():
     check_batch(rd.rnea, random_model(6, seed=11, floating_base=True), ("q", "v", "a"))
 
 
+def test_leading_dimensions_broadcast():
+    """Leading (batch) dimensions broadcast as NumPy's do, not only a single state against a batch."""
+    model = random_model(4, seed=13, floating_base=True)
+    q, v, a = states(model, "broadcast", size=(2, 3))
+    out = rd.rnea(model, q[:, :1], v[:1], a)  # (2, 1, nq), (1, 3, nv), (2, 3, nv)
+    assert out.shape == (2, 3, model.nv)
+    for i, j in np.ndindex(2, 3):
+        assert_rel(out[i, j], rd.rnea(model, q[i, 0], v[0, j], a[i, j]), 1e-12)
+
+
+def test_non_numeric_input():
+    model = random_model(3, seed=1)
+    q, v, a = states(model)
+    with pytest.raises(ValueError, match=r"^q: expected an array of numbers, got str$"):
+        rd.rnea(model, "q", v, a)
+    with pytest.raises(ValueError, match=r"^v: expected an array of numbers, got dict$"):
+        rd.rnea(model, q, {"v": 1.0}, a)
+
+
 def test_batch_with_external_wrenches():
     """f_ext with the batch's shape pairs element by element; one f_ext (nb, 6) is shared."""
     model = random_model(5, seed=12, floating_base=False)
@@ -132,7 +153,11 @@ def test_bad_external_wrenches():
     f[1, 2] = np.nan
     with pytest.raises(ValueError, match="^f_ext: contains NaN"):
         rd.rnea(model, q, v, a, f)
-    with pytest.raises(ValueError, match="^f_ext: batch shape"):
+    with pytest.raises(ValueError, match=r"^f_ext: batch shape \(4,\) does not match the states' \(\)$"):
         rd.rnea(model, q, v, a, np.zeros((4, nb, 6)))  # would enlarge an unbatched call
+    three = [np.stack([x] * 3) for x in (q, v, a)]
+    for batch in ((2, 3), (2,)):  # would enlarge the batch; does not broadcast
+        with pytest.raises(ValueError, match=re.escape(f"f_ext: batch shape {batch} does not match the states' (3,)")):
+            rd.rnea(model, *three, np.zeros(batch + (nb, 6)))
     with pytest.raises(ValueError, match="^frame must be one of"):
         rd.rnea(model, q, v, a, np.zeros((nb, 6)), frame="body")

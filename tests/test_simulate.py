@@ -12,6 +12,7 @@ from scipy.integrate import solve_ivp
 
 import robodyn as rd
 from robodyn import control
+from robodyn.io.log import write_log
 from robodyn.random import random_model, random_state
 from robodyn.simulation import read_trajectory
 from robodyn.simulation.simulate import Progress
@@ -184,6 +185,17 @@ def test_csv_with_positions_only_is_differentiated(tmp_path):
     _, q_read, v, a = read_trajectory(path, model)
     np.testing.assert_allclose(q_read, q, rtol=0, atol=1e-15)
     np.testing.assert_allclose(v[20:-20], np.stack([2 * np.cos(2 * t), 3 * t ** 2], 1)[20:-20], rtol=0, atol=1e-5)
+    np.testing.assert_allclose(a[20:-20], np.stack([-4 * np.sin(2 * t), 6 * t], 1)[20:-20], rtol=0, atol=1e-3)
+
+
+def test_csv_with_velocities_only_gets_the_accelerations(tmp_path):
+    """v given, a not: v is read as written, a comes from the spline through q."""
+    model = rd.models.load("double_pendulum")
+    t = np.linspace(0, 1, 201)
+    q = np.stack([np.sin(2 * t), t ** 3], axis=1)
+    v = np.stack([2 * np.cos(2 * t), 3 * t ** 2], axis=1)
+    _, _, v_read, a = read_trajectory(write_log(tmp_path / "qv.csv", model, t, q, v=v), model)
+    np.testing.assert_array_equal(v_read, v)
     np.testing.assert_allclose(a[20:-20], np.stack([-4 * np.sin(2 * t), 6 * t], 1)[20:-20], rtol=0, atol=1e-3)
 
 

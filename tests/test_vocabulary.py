@@ -6,6 +6,7 @@ a deprecation warning, and coordinate names come from ``Model.q_names`` / ``Mode
 from __future__ import annotations
 
 import csv
+import warnings
 
 import numpy as np
 import pytest
@@ -86,6 +87,24 @@ def test_write_read_round_trip_csv_and_parquet(tmp_path):
         write_log(tmp_path / "bad.csv", model, t, q, tau=tau[:, :-1])
     with pytest.raises(ValueError, match="repeats a column"):
         write_log(tmp_path / "bad.csv", model, t, q, extra={"t": t})
+    q[2, 0] = np.nan  # a Parquet file's rows are numbered from 1 in the messages
+    with pytest.raises(ValueError, match=r"1 rows with missing or non-finite values at lines \[3\]"):
+        read_log(write_log(tmp_path / "nan.parquet", model, t, q), model)
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({}), tmp_path / "no-columns.parquet")
+    with pytest.raises(ValueError, match=r"no-columns.parquet: missing columns \['t', "):
+        read_log(tmp_path / "no-columns.parquet", model)
+    for column in (["a"] * n, [{"x": 1.0}] * n):  # text, and a structure
+        pq.write_table(pa.table({"t": t, "q:arm": column}), tmp_path / "text.parquet")
+        with pytest.raises(ValueError, match=r"text.parquet: non-numeric column"):
+            read_log(tmp_path / "text.parquet", model)
+    with pytest.raises(TypeError):
+        write_log(tmp_path / "bad.csv", model, t, q, v)  # v, a, tau and extra are keywords only
+    log = read_log(path, model)
+    with pytest.raises(AttributeError):  # a frozen dataclass
+        log.t = t
 
 
 def test_names_come_from_one_table():
@@ -133,20 +152,33 @@ def test_the_old_log_spelling_is_read_with_a_warning(tmp_path):
         w = csv.writer(f)
         w.writerow(header)
         w.writerows(np.hstack([t[:, None], q, v, a, tau]).tolist())
-    with pytest.warns(RobodynDeprecationWarning, match=r"time, q_<joint>.*t, q:<joint>"):
+    with pytest.warns(RobodynDeprecationWarning, match=r"time, q_<joint>.*t, q:<joint>") as caught:
         log = read_log(old, model, require_tau=True)
+    assert caught[0].filename == __file__  # the warning points at the caller's line
     for x, y in ((log.t, t), (log.q, q), (log.v, v), (log.a, a), (log.tau, tau)):
         np.testing.assert_array_equal(x, y)
     with pytest.warns(RobodynDeprecationWarning):
         assert read_trajectory(old, model)[2] is not None
+    # a file with t is in the new spelling: a column spelt the old way is an extra, without a warning;
+    # without t and without the old names there is nothing to rename (and no warning)
+    new = tmp_path / "new.csv"
+    write_log(new, model, t, q, extra={"tau_joint1": tau[:, 0]})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        log = read_log(new, model)
+        assert log.tau is None and list(log.extra) == ["tau_joint1"]
+        new.write_text("seconds,q:joint1,q:joint2\n0,0,0\n1,1,1\n")
+        with pytest.raises(ValueError, match=r"missing columns \['t'\]"):
+            read_log(new, model)
 
 
 def test_text_columns(tmp_path):
     model = rd.models.load("planar_2r")
     path = tmp_path / "notes.csv"
     path.write_text("t,q:joint1,q:joint2,note\n0,0,0,start\n0.1,1,1,\n0.2,2,2,end\n")
-    with pytest.warns(RobodynWarning, match=r"columns \['note'\] hold text and are not read"):
+    with pytest.warns(RobodynWarning, match=r"columns \['note'\] hold text and are not read") as caught:
         log = read_log(path, model)
+    assert caught[0].filename == __file__  # the warning points at the caller's line
     assert log.extra == {} and log.q.shape == (3, 2)
     path.write_text("t,q:joint1,q:joint2\n0,0,0\n0.1,x,1\n0.2,2,2\n")
     with pytest.raises(ValueError, match=r"line 3, column 'q:joint1': not a number: 'x'"):
@@ -171,7 +203,7 @@ def test_parquet_needs_pyarrow_and_says_so(tmp_path, monkeypatch):
 
 
 # -- the old names: same results, one warning each ----------------------------------------------
-def test_old_keywords_give_the_same_results_with_a_warning():
+def test_old_keywords_give_the_same_results_with_a_warning(tmp_path):
     model = rd.models.load("panda")
     rng = rng_for("old-keywords")
     q, v, a = rng.standard_normal(7), rng.standard_normal(7), rng.standard_normal(7)
@@ -191,6 +223,14 @@ def test_old_keywords_give_the_same_results_with_a_warning():
     np.testing.assert_array_equal(old, rd.regressor(model, q, v, a, damping=True))
     with pytest.raises(TypeError, match="got both 'viscous'"):
         rd.regressor(model, q, v, a, viscous=True, damping=True)
+    t, path = np.arange(3) * 0.1, tmp_path / "old-keywords.csv"
+    with pytest.warns(RobodynDeprecationWarning) as caught:
+        write_log(path, model, t, np.tile(q, (3, 1)), qd=np.tile(v, (3, 1)), qdd=np.tile(a, (3, 1)))
+    assert sorted(str(w.message) for w in caught) == ["write_log(): 'qd' is deprecated, use 'v'",
+                                                      "write_log(): 'qdd' is deprecated, use 'a'"]
+    log = read_log(path, model)
+    np.testing.assert_array_equal(log.v, np.tile(v, (3, 1)))
+    np.testing.assert_array_equal(log.a, np.tile(a, (3, 1)))
     with pytest.warns(RobodynDeprecationWarning, match="'viscous' is deprecated"):
         assert ident.base_parameters(rd.models.load("planar_2r"), viscous=True).count == \
             ident.base_parameters(rd.models.load("planar_2r"), damping=True).count
@@ -269,3 +309,10 @@ def test_a_link_is_a_body_and_readers_take_the_path_first(tmp_path):
     with pytest.warns(RobodynDeprecationWarning, match=r"Sampled.from_csv\(path, model\)"):
         old_ref = control.Sampled.from_csv(model, path)
     np.testing.assert_array_equal(old_ref(0.25)[0], ref(0.25)[0])
+
+
+def test_a_parquet_path_that_is_not_parquet(tmp_path):
+    bad = tmp_path / "log.parquet"
+    bad.write_text("t,q:joint1\n0,0\n")
+    with pytest.raises(ValueError, match=r"log.parquet: not a Parquet file"):
+        read_log(bad, rd.models.load("planar_2r"))

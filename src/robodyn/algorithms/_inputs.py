@@ -139,7 +139,7 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
             raise ValueError(f"f_ext: batch shape {f.shape[:-2]} does not match the states' {batch}")
         f = np.broadcast_to(f, batch + (nb, 6))
     f = np.ascontiguousarray(f if batch == () else f.reshape(-1, nb, 6)).view()
-    f.flags.writeable = False  # read-only as the model's zero wrenches: one compiled specialisation
+    f.flags.writeable = False  # the caller's array without a copy: the kernels only read it
     return f, codes[frame]
 
 

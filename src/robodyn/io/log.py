@@ -218,7 +218,7 @@ def _read_table(path: Path) -> tuple[list[str], np.ndarray, np.ndarray, dict]:
         _, pq = _pyarrow()
         try:
             table = pq.read_table(path)
-        except OSError as e:
+        except (OSError, ValueError) as e:  # pyarrow's ArrowInvalid is a ValueError
             raise ValueError(f"{path}: not a Parquet file ({e})") from None
         header = [str(n).strip() for n in table.column_names]
         try:
