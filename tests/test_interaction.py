@@ -156,3 +156,24 @@ def test_admittance_yields_as_its_virtual_spring():
     assert_rel(run.controller_state[-1, :3], x, 1e-4)  # the hand is where the virtual mass is
     with pytest.raises(ValueError, match="force: expected a callable"):
         control.Admittance(model, "link7", x0, f, mass=1.0, damping=1.0, stiffness=1.0, kp=1.0, kd=1.0)
+
+
+def test_workspace_computed_torque_on_a_non_redundant_arm():
+    """MLS's workspace computed torque on the 3-joint elbow arm tracking a moving point: the
+    error follows e'' + Kd e' + Kp e = 0 (here from e(0) with e'(0) = x_d'(0)), to 1e-6; a
+    redundant task is refused."""
+    model = rd.models.load("elbow_3r")
+    q0 = np.array([0.3, 0.4, -0.8])
+    x0 = rd.frame_pose(model, q0, "frame3")[:3, 3]
+    w, s = 6.0, 0.02
+    def target(t):
+        return x0 + [s * np.sin(t), 0.01, 0.0], [s * np.cos(t), 0.0, 0.0], [-s * np.sin(t), 0.0, 0.0]
+
+    ctrl = control.WorkspaceComputedTorque(model, "frame3", target, w * w, 2 * w)
+    run = rd.simulate(model, q0, np.zeros(3), 1.0, 1e-3, controller=ctrl, integrator="rk4")
+    e = np.array([target(t)[0] - ctrl.position(q) for t, q in zip(run.t, run.q)])
+    e0, ed0 = e[0], np.array([s, 0.0, 0.0])  # the arm starts at rest, the target moving
+    expected = (e0[None] + (ed0 + w * e0)[None] * run.t[:, None]) * np.exp(-w * run.t)[:, None]
+    assert_rel(e, expected, 1e-6)
+    with pytest.raises(ValueError, match="as many task rows as joints"):
+        control.WorkspaceComputedTorque(rd.models.load("panda"), "link7", np.zeros(3), 1.0, 1.0)

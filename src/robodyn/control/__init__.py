@@ -9,9 +9,12 @@
 
 from .controllers import (AdaptiveSlotineLi, ComputedTorque, Controller, JointPD, PDGravity, PIDGravity, SlotineLi,
                           TaskSpacePD)
-from .interaction import Admittance, CartesianImpedance, HybridForcePosition, OperationalSpace, rotation_vector
+from .interaction import (Admittance, CartesianImpedance, HybridForcePosition, OperationalSpace,
+                          WorkspaceComputedTorque, rotation_vector)
 from .references import PointToPoint, Sampled, cubic, quintic
 from .whole_body import WholeBodyID, whole_body_inverse_dynamics
 
-__all__ = ["Controller", "CartesianImpedance", "HybridForcePosition", "OperationalSpace", "Admittance", "rotation_vector", "WholeBodyID", "whole_body_inverse_dynamics", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "PointToPoint", "Sampled",
-           "cubic", "quintic", "AdaptiveSlotineLi", "JointPD"]
+__all__ = ["Controller", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "AdaptiveSlotineLi",
+           "JointPD", "CartesianImpedance", "HybridForcePosition", "OperationalSpace", "Admittance",
+           "WorkspaceComputedTorque", "rotation_vector", "WholeBodyID", "whole_body_inverse_dynamics", "PointToPoint",
+           "Sampled", "cubic", "quintic"]

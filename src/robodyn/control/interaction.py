@@ -238,3 +238,33 @@ class Admittance(OperationalSpace):
     def state_rate(self, t, q, v, z):
         m = self.index.size
         return np.concatenate([z[m:], self._accel(t, q, v, z)[1]])
+
+
+class WorkspaceComputedTorque(OperationalSpace):
+    """Murray, Li & Sastry's workspace computed torque (ch. 4, section 5.3) for a
+    non-redundant arm (as many task rows as joints, ``J`` square and invertible):
+
+        tau = M J^-1 (x_d'' - Jdot v + Kd (x_d' - x') + Kp (x_d - x)) + C v + g
+
+    the task error obeying ``e'' + Kd e' + Kp e = 0``. For such arms it is
+    :class:`OperationalSpace` without a null space (``J^T Lambda = M J^-1``); written here in
+    the book's form."""
+
+    def __init__(self, model, body: str, target, kp, kd, *, rows="linear"):
+        super().__init__(model, body, target, kp, kd, rows=rows)
+        if self.index.size != model.nv:
+            raise ValueError(f"WorkspaceComputedTorque: a non-redundant arm needs as many task rows as joints "
+                             f"({model.nv}), got {self.index.size}; use OperationalSpace")
+
+    def law(self, q, v, x_d, xd_d, xdd_d, force=0.0):
+        if np.any(self.index > 2):
+            raise ValueError(f"{type(self).__name__}: position rows (0-2) only")
+        from ..algorithms.crba import crba
+        from ..algorithms.jacobian import jacobian_dot_times_v
+        from ..algorithms.terms import nonlinear_effects
+
+        J = jacobian(self.model, q, self.body, "local_world_aligned")[self.index]
+        Jdv = jacobian_dot_times_v(self.model, q, v, self.body, "local_world_aligned")[self.index]
+        e, ed = np.asarray(x_d, float) - self.position(q), np.asarray(xd_d, float) - J @ v
+        y = np.linalg.solve(J, np.asarray(xdd_d, float) - Jdv + self.kd * ed + self.kp * e)
+        return crba(self.model, q) @ y + nonlinear_effects(self.model, q, v) - J.T @ np.broadcast_to(force, (len(y),))
