@@ -127,8 +127,7 @@ class FlexibleJoints(Controller):
     the spring's. ``u = motor_law(t, q, v, theta, theta')`` is the motor torque (nv,), e.g.
     :func:`motor_pd_gravity`. Large ``K`` makes the system stiff: use an implicit integrator
     (``"Radau"``) or a step well below ``sqrt(B / K)``. Reference: M. W. Spong, "Modeling and
-    control of elastic joint robots", J. Dyn. Sys., Meas., Control 109 (1987); Spong,
-    Hutchinson & Vidyasagar (2006), section 8.x.
+    control of elastic joint robots", J. Dyn. Sys., Meas., Control 109 (1987).
     """
 
     def __init__(self, model, stiffness, motor_inertia, motor_law=None, *, damping=0.0, theta0=None):

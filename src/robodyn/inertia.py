@@ -27,75 +27,24 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._algebra import Algebra, is_symbolic
+
 __all__ = ["rod", "cylinder", "box", "sphere", "point", "shift", "rotate", "axisymmetric", "parameters"]
 
 
-def _symbolic(*args) -> bool:
-    """Whether any entry of the arguments is a sympy object."""
-    for a in args:
-        items = a if isinstance(a, (list, tuple)) else [a]
-        if any(type(x).__module__.split(".")[0] == "sympy" for x in items):
-            return True
-    return False
-
-
-class _Algebra:
-    """The few matrix operations of the helpers, in NumPy or in sympy."""
-
-    def __init__(self, symbolic: bool):
-        self.symbolic = symbolic
-        if symbolic:
-            import sympy as sp
-
-            self.sp = sp
-
-    def vector(self, x, what: str):
-        if self.symbolic:
-            v = self.sp.Matrix(x).reshape(3, 1) if len(x) == 3 else None
-        else:
-            v = np.asarray(x, dtype=float)
-            v = v if v.shape == (3,) and np.all(np.isfinite(v)) else None
-        if v is None:
-            raise ValueError(f"{what}: expected 3 finite numbers, got {x!r}")
-        return v
-
-    def matrix(self, x, what: str):
-        if self.symbolic:
-            m = self.sp.Matrix(x)
-            ok = m.shape == (3, 3)
-        else:
-            m = np.asarray(x, dtype=float)
-            ok = m.shape == (3, 3) and bool(np.all(np.isfinite(m)))
-        if not ok:
-            raise ValueError(f"{what}: expected a finite 3 x 3 matrix, got {x!r}")
-        return m
-
-    def eye(self):
-        return self.sp.eye(3) if self.symbolic else np.eye(3)
-
-    def outer(self, u):
-        return u * u.T if self.symbolic else np.outer(u, u)
-
-    def dot(self, u):
-        return (u.T * u)[0] if self.symbolic else float(u @ u)
-
-    def transpose_product(self, R, I):
-        return R * I * R.T if self.symbolic else R @ I @ R.T
-
-
 def _nonnegative(x, what: str):
-    if not _symbolic(x) and not (np.isfinite(x) and x >= 0):
+    if not is_symbolic(x) and not (np.isfinite(x) and x >= 0):
         raise ValueError(f"{what}: expected a finite number >= 0, got {x!r}")
     return x
 
 
-def _axis(alg: _Algebra, axis):
+def _axis(alg: Algebra, axis):
     if isinstance(axis, str):
         if axis not in ("x", "y", "z"):
             raise ValueError(f"axis: expected 'x', 'y', 'z' or a unit vector, got {axis!r}")
         return alg.vector([1 if axis == c else 0 for c in "xyz"], "axis")
     a = alg.vector(axis, "axis")
-    n = alg.dot(a)
+    n = alg.dot(a, a)
     if not alg.symbolic and abs(n - 1.0) > 1e-9:
         raise ValueError(f"axis: expected a unit vector, got {axis!r} (norm {np.sqrt(n):.6g})")
     return a
@@ -104,7 +53,7 @@ def _axis(alg: _Algebra, axis):
 def axisymmetric(axial, transverse, axis="z"):
     """``axial a a^T + transverse (1 - a a^T)``: moment ``axial`` about the unit axis ``a``,
     ``transverse`` about every axis across it."""
-    alg = _Algebra(_symbolic(axial, transverse, axis if not isinstance(axis, str) else 0))
+    alg = Algebra(is_symbolic(axial, transverse, 0 if isinstance(axis, str) else axis))
     a = _axis(alg, axis)
     aa = alg.outer(a)
     return aa * axial + (alg.eye() - aa) * transverse
@@ -127,7 +76,7 @@ def cylinder(mass, radius, length, axis="z"):
 def box(mass, size):
     """A uniform box with edges ``size = (a, b, c)`` along x, y, z, about its centre:
     ``m / 12 diag(b^2 + c^2, a^2 + c^2, a^2 + b^2)``."""
-    alg = _Algebra(_symbolic(mass, list(size)))
+    alg = Algebra(is_symbolic(mass, size))
     if len(size) != 3:
         raise ValueError(f"size: expected 3 edge lengths, got {size!r}")
     a, b, c = (_nonnegative(x, "size") for x in size)
@@ -140,7 +89,7 @@ def sphere(mass, radius, hollow: bool = False):
     """A uniform solid sphere about its centre, ``2/5 m r^2`` (a thin shell with
     ``hollow=True``: ``2/3 m r^2``)."""
     _nonnegative(mass, "mass"), _nonnegative(radius, "radius")
-    alg = _Algebra(_symbolic(mass, radius))
+    alg = Algebra(is_symbolic(mass, radius))
     k = (alg.sp.Rational(2, 3) if hollow else alg.sp.Rational(2, 5)) if alg.symbolic else (2 / 3 if hollow else 0.4)
     return alg.eye() * (k * mass * radius**2)
 
@@ -148,34 +97,32 @@ def sphere(mass, radius, hollow: bool = False):
 def point(mass, position):
     """A point mass at ``position``, about the origin: ``m (|p|^2 1 - p p^T)``."""
     _nonnegative(mass, "mass")
-    alg = _Algebra(_symbolic(mass, list(position)))
+    alg = Algebra(is_symbolic(mass, position))
     p = alg.vector(position, "position")
-    return (alg.eye() * alg.dot(p) - alg.outer(p)) * mass
+    return (alg.eye() * alg.dot(p, p) - alg.outer(p)) * mass
 
 
 def shift(inertia_com, mass, d):
     """The parallel-axis theorem: the inertia ``I_c`` of a body of ``mass`` about its centre
     of mass, moved to the point from which the centre of mass is at ``d`` (same axes):
     ``I_c + m (|d|^2 1 - d d^T)``."""
-    sym = _symbolic(mass, list(d), *np.asarray(inertia_com, dtype=object).ravel().tolist())
-    alg = _Algebra(sym)
+    alg = Algebra(is_symbolic(mass, d, inertia_com))
     return alg.matrix(inertia_com, "inertia_com") + point(mass, d)
 
 
 def rotate(inertia, R):
     """``R I R^T``: the inertia ``I`` expressed in axes rotated by ``R`` (the columns of ``R``
     are the old axes in the new ones)."""
-    sym = _symbolic(*np.asarray(inertia, dtype=object).ravel().tolist(), *np.asarray(R, dtype=object).ravel().tolist())
-    alg = _Algebra(sym)
-    return alg.transpose_product(alg.matrix(R, "R"), alg.matrix(inertia, "inertia"))
+    alg = Algebra(is_symbolic(inertia, R))
+    R = alg.matrix(R, "R")
+    return R @ alg.matrix(inertia, "inertia") @ R.T
 
 
 def parameters(mass, com, inertia_com):
     """The 10 inertial parameters ``[m, m cx, m cy, m cz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]``
     about the frame origin (a row of ``Model.theta``) from the mass, the centre of mass and
     the inertia about it."""
-    sym = _symbolic(mass, list(com), *np.asarray(inertia_com, dtype=object).ravel().tolist())
-    if sym:
+    if is_symbolic(mass, com, inertia_com):
         from .symbolic.model import inertial_parameters
 
         return inertial_parameters(mass, com, inertia_com)

@@ -32,10 +32,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..algorithms.jacobian import jacobian
+from ..algorithms.crba import crba
+from ..algorithms.jacobian import jacobian, jacobian_dot_times_v
 from ..algorithms.kinematics import frame_pose
 from ..algorithms.task_space import task_rows, task_space_dynamics
-from ..algorithms.terms import gravity
+from ..algorithms.terms import gravity, nonlinear_effects
 from .controllers import Controller, gain
 
 
@@ -168,8 +169,10 @@ class OperationalSpace(Controller):
                  rows="linear"):
         super().__init__(model)
         model.frame_index(body)
-        self.body, self.rows = body, rows
+        self.body = body
         self.index = task_rows(rows)[0]
+        if np.any(self.index > 2):
+            raise ValueError(f"{type(self).__name__}: position rows (0-2) only, got rows {rows!r}")
         m = self.index.size
         if not callable(target):
             fixed = np.array(target, dtype=float)
@@ -193,8 +196,6 @@ class OperationalSpace(Controller):
     def law(self, q, v, x_d, xd_d, xdd_d, force=0.0):
         """The joint torques for the task reference ``(x_d, x_d', x_d'')`` (module docstring),
         compensating a known external force ``force`` (m,) on the frame."""
-        if np.any(self.index > 2):
-            raise ValueError(f"{type(self).__name__}: position rows (0-2) only")
         T = task_space_dynamics(self.model, q, v, self.body, "local_world_aligned", self.index)
         x_d, xd_d, xdd_d = (np.asarray(y, dtype=float) for y in (x_d, xd_d, xdd_d))
         e, ed = x_d - self.position(q), xd_d - T.J @ v
@@ -257,12 +258,6 @@ class WorkspaceComputedTorque(OperationalSpace):
                              f"({model.nv}), got {self.index.size}; use OperationalSpace")
 
     def law(self, q, v, x_d, xd_d, xdd_d, force=0.0):
-        if np.any(self.index > 2):
-            raise ValueError(f"{type(self).__name__}: position rows (0-2) only")
-        from ..algorithms.crba import crba
-        from ..algorithms.jacobian import jacobian_dot_times_v
-        from ..algorithms.terms import nonlinear_effects
-
         J = jacobian(self.model, q, self.body, "local_world_aligned")[self.index]
         Jdv = jacobian_dot_times_v(self.model, q, v, self.body, "local_world_aligned")[self.index]
         e, ed = np.asarray(x_d, float) - self.position(q), np.asarray(xd_d, float) - J @ v

@@ -51,7 +51,7 @@ def actuated_dofs(model) -> np.ndarray:
 
 
 def whole_body_inverse_dynamics(model, q, v, a, contacts, *, mu=1.0, normal=(0.0, 0.0, 1.0),
-                                force_weight: float = 1e-4, tol: float = 1e-9) -> WholeBodyID:
+                                force_weight: float = 1e-4, tol: float = 1e-6) -> WholeBodyID:
     """Torques and contact forces for the accelerations ``a`` (module docstring).
 
     Args:
@@ -60,6 +60,9 @@ def whole_body_inverse_dynamics(model, q, v, a, contacts, *, mu=1.0, normal=(0.0
         mu: friction coefficient, a number or one per contact. normal: the contact normal in
             world axes (one for all, or (k, 3)), unit.
         force_weight: ``w``, the weight of the contact forces' squares against the torques'.
+        tol: the violations accepted, relative to the largest joint force ``|b|``: of the base
+            rows of the equation of motion, of the cones (``f_n >= 0``, ``|f_t| <= mu f_n``)
+            and of the torque limits.
     """
     from scipy.optimize import minimize
 
@@ -102,7 +105,7 @@ def whole_body_inverse_dynamics(model, q, v, a, contacts, *, mu=1.0, normal=(0.0
     if np.any(finite):
         constraints.append({"type": "ineq", "fun": lambda f: np.concatenate([limit - torques(f), limit + torques(f)])[
             np.concatenate([finite, finite])]})
-    # start: the least-squares forces of the base rows, pushed along the normals
+    # start: the least-squares forces of the base rows
     f0 = np.linalg.lstsq(Jc.T[base], b[base], rcond=None)[0] if base.size else np.zeros(3 * k)
     result = minimize(objective, f0, jac=gradient, constraints=constraints, method="SLSQP",
                       options={"maxiter": 500, "ftol": 1e-14})
@@ -110,15 +113,15 @@ def whole_body_inverse_dynamics(model, q, v, a, contacts, *, mu=1.0, normal=(0.0
     residual = float(np.abs((b - Jc.T @ f)[base]).max()) if base.size else 0.0
     scale = max(1.0, float(np.abs(b).max()))
     violated = []
-    if residual > tol * scale * 1e3:
+    if residual > tol * scale:
         violated.append(f"the base's equation of motion (residual {residual:.3g})")
     c = cones(f)
-    if np.any(c < -1e-6 * scale ** 2):
-        bad = [contacts[i] for i in range(k) if c[i] < -1e-6 * scale or c[k + i] < -1e-6 * scale ** 2]
-        violated.append(f"the friction cones of {bad}")
+    outside = (c[:k] < -tol * scale) | (c[k:] < -tol * scale ** 2)   # f_n >= 0, (mu f_n)^2 >= |f_t|^2
+    if np.any(outside):
+        violated.append(f"the friction cones of {[contacts[i] for i in np.flatnonzero(outside)]}")
     tau = np.zeros(model.nv)
     tau[act] = torques(f)
-    if np.any(np.abs(tau[act]) > limit * (1 + 1e-6)):
+    if np.any(np.abs(tau[act]) > limit * (1 + tol)):
         violated.append("the torque limits")
     if violated:
         raise ValueError(f"whole_body_inverse_dynamics: no admissible contact forces for these accelerations: "

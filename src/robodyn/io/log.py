@@ -132,7 +132,7 @@ def read_log(path, model, *, require_tau: bool = False) -> Log:
     if missing:
         raise ValueError(f"{path}: missing columns {missing} for model {model.name!r}; expected t, q:<coordinate>"
                          f"{', tau:<dof>' if require_tau else ''} with coordinates {model.q_names}")
-    blocks = {}
+    kinds = []
     for kind in KINDS:
         names = columns(model, kind)
         present = [n for n in names if n in index]
@@ -140,17 +140,18 @@ def read_log(path, model, *, require_tau: bool = False) -> Log:
             raise ValueError(f"{path}: {kind} given for some entries only; missing columns "
                              f"{[n for n in names if n not in index]}")
         if present:
-            blocks[kind] = [index[n] for n in names]
-    used = {index["t"]} | {c for cols in blocks.values() for c in cols}
-    for c in sorted(used & set(text)):
-        raise ValueError(text[c])
+            kinds.append(kind)
+    wanted = {"t"} | {n for kind in kinds for n in columns(model, kind)}
+    for c in sorted(text):
+        if header[c] in wanted:
+            raise ValueError(text[c])
     if text:
-        warnings.warn(f"{path}: columns {[header[c] for c in sorted(set(text) - used)]} hold text and are not read",
+        warnings.warn(f"{path}: columns {[header[c] for c in sorted(text)]} hold text and are not read",
                       RobodynWarning, stacklevel=2)
         keep = [k for k in range(len(header)) if k not in text]
         header, data = [header[k] for k in keep], data[:, keep]
         index = {name: k for k, name in enumerate(header)}
-        blocks = {kind: [index[n] for n in columns(model, kind)] for kind in blocks}
+    blocks = {kind: [index[n] for n in columns(model, kind)] for kind in kinds}
     if data.shape[0] < 2:
         raise ValueError(f"{path}: {data.shape[0]} data rows, need at least 2")
     bad = ~np.isfinite(data).all(axis=1)
@@ -164,8 +165,7 @@ def read_log(path, model, *, require_tau: bool = False) -> Log:
         k = int(np.flatnonzero(step <= 0)[0])
         raise ValueError(f"{path}: time not strictly increasing at line {lines[k + 1]} "
                          f"(t = {float(t[k + 1])!r} after {float(t[k])!r} on line {lines[k]})")
-    used = {index["t"]} | {c for cols in blocks.values() for c in cols}
-    extra = {h: data[:, k].copy() for k, h in enumerate(header) if k not in used}
+    extra = {h: data[:, k].copy() for h, k in index.items() if h not in wanted}
     return Log(t=t, **{kind: data[:, cols].copy() for kind, cols in blocks.items()}, extra=extra)
 
 

@@ -27,45 +27,10 @@ from typing import Sequence
 
 import numpy as np
 
+from .._algebra import Algebra, is_symbolic
 from ..model import Model, ModelError
 
 AXIS_TOL = 1e-9  # |w| must be 0 or 1 within this
-
-
-def _symbolic(*arrays) -> bool:
-    return any(type(x).__module__.split(".")[0] == "sympy"
-               for a in arrays for x in np.asarray(a, dtype=object).ravel())
-
-
-class _Ops:
-    """3-vectors and 3 x 3 matrices in NumPy or sympy."""
-
-    def __init__(self, symbolic: bool):
-        self.symbolic = symbolic
-        if symbolic:
-            import sympy as sp
-
-            self.sp = sp
-
-    def vec(self, x):
-        return self.sp.Matrix(3, 1, list(x)) if self.symbolic else np.asarray(x, dtype=float).reshape(3)
-
-    def mat(self, x):
-        return self.sp.Matrix(x) if self.symbolic else np.asarray(x, dtype=float)
-
-    def dot(self, a, b):
-        return (a.T * b)[0] if self.symbolic else float(a @ b)
-
-    def cross(self, a, b):
-        return a.cross(b) if self.symbolic else np.cross(a, b)
-
-    def is_zero(self, a) -> bool:
-        if self.symbolic:
-            return all(self.sp.simplify(x) == 0 for x in a)
-        return bool(np.linalg.norm(a) <= AXIS_TOL)
-
-    def simplify(self, x):
-        return x.applyfunc(self.sp.simplify) if self.symbolic else x
 
 
 def poe_tree(twists, home, parents=None, where: str = "from_poe"):
@@ -80,15 +45,16 @@ def poe_tree(twists, home, parents=None, where: str = "from_poe"):
     parents = list(range(-1, n - 1)) if parents is None else [int(p) for p in parents]
     if len(parents) != n or any(not -1 <= p < i for i, p in enumerate(parents)):
         raise ModelError(f"{where}: parents must list one index per joint with -1 <= parent < joint, got {parents}")
-    ops = _Ops(_symbolic(*twists, *home))
+    ops = Algebra(is_symbolic(*twists, *home))
     frames, out = [], []
     for i in range(n):
-        xi, g = list(np.asarray(twists[i], dtype=object).ravel()), ops.mat(home[i])
-        if len(xi) != 6 or tuple(g.shape) != (4, 4):
-            raise ModelError(f"{where}: joint {i + 1}: a twist has 6 entries (v, w) and a home pose is 4 x 4")
-        v, w = ops.vec(xi[:3]), ops.vec(xi[3:])
-        R, p = g[:3, :3], ops.vec([g[k, 3] for k in range(3)])
-        if ops.is_zero(w):
+        xi = list(np.asarray(twists[i], dtype=object).ravel())
+        if len(xi) != 6:
+            raise ModelError(f"{where}: joint {i + 1}: a twist has 6 entries (v, w), got {len(xi)}")
+        g = ops.matrix(home[i], f"{where}: joint {i + 1}: home pose", (4, 4))
+        v, w = ops.vector(xi[:3], f"{where}: twist {i + 1}"), ops.vector(xi[3:], f"{where}: twist {i + 1}")
+        R, p = g[:3, :3], ops.vector([g[k, 3] for k in range(3)], f"{where}: home pose {i + 1}")
+        if ops.is_zero(w, AXIS_TOL):
             if not ops.symbolic and abs(np.linalg.norm(v) - 1.0) > AXIS_TOL:
                 raise ModelError(f"{where}: joint {i + 1}: a prismatic twist (0, v) needs |v| = 1, "
                                  f"got {np.linalg.norm(v):.6g}")
@@ -108,10 +74,9 @@ def poe_tree(twists, home, parents=None, where: str = "from_poe"):
             R_tree, p_tree = R, origin
         else:
             Rp, pp = frames[parent]
-            R_tree, p_tree = Rp.T @ R if not ops.symbolic else Rp.T * R, (Rp.T @ (origin - pp) if not ops.symbolic
-                                                                           else Rp.T * (origin - pp))
-        local_axis = R.T @ axis if not ops.symbolic else R.T * axis
-        offset = R.T @ (p - origin) if not ops.symbolic else R.T * (p - origin)
+            R_tree, p_tree = Rp.T @ R, Rp.T @ (origin - pp)
+        local_axis = R.T @ axis
+        offset = R.T @ (p - origin)
         out.append((kind, parent, ops.simplify(local_axis), pitch, ops.simplify(R_tree), ops.simplify(p_tree),
                     ops.simplify(offset)))
     return out
