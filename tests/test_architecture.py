@@ -145,10 +145,13 @@ def test_no_import_cycle():
 # Packages that a module of the key may not import (ARCHITECTURE.md, "Layers").
 FORBIDDEN = {
     "robodyn.algorithms": ("robodyn.simulation", "robodyn.control", "robodyn.identification", "robodyn.symbolic",
-                           "robodyn.cli", "robodyn.interop", "robodyn.contact"),
-    "robodyn.contact": ("robodyn.simulation", "robodyn.control", "robodyn.identification", "robodyn.cli"),
-    "robodyn.control": ("robodyn.simulation", "robodyn.identification", "robodyn.cli"),
-    "robodyn.simulation": ("robodyn.identification", "robodyn.cli"),
+                           "robodyn.cli", "robodyn.interop", "robodyn.contact", "robodyn.distributed"),
+    "robodyn.contact": ("robodyn.simulation", "robodyn.control", "robodyn.identification", "robodyn.cli",
+                        "robodyn.distributed"),
+    "robodyn.control": ("robodyn.simulation", "robodyn.identification", "robodyn.cli", "robodyn.distributed"),
+    "robodyn.simulation": ("robodyn.identification", "robodyn.cli", "robodyn.distributed"),
+    "robodyn.identification": ("robodyn.cli", "robodyn.distributed"),
+    "robodyn.distributed": ("robodyn.cli",),
     "robodyn.io": ("robodyn.algorithms", "robodyn.simulation", "robodyn.control", "robodyn.cli"),
     "robodyn.interop": ("robodyn.algorithms", "robodyn.simulation", "robodyn.control", "robodyn.cli"),
     "robodyn": ("robodyn.cli",),  # nothing outside the command line imports it

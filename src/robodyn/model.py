@@ -340,6 +340,26 @@ class Model:
     def __delattr__(self, key):
         raise AttributeError("Model is immutable; use with_inertial_parameters() or replace()")
 
+    # -- pickling (Dask workers, multiprocessing), copies and content tokens ------------------
+    def __getstate__(self) -> dict:
+        """The fields, without the kernel tables (rebuilt on unpickling)."""
+        return {key: getattr(self, key) for key in self.__slots__ if key != "kernel"}
+
+    def __setstate__(self, state: dict) -> None:
+        for key, value in state.items():
+            if isinstance(value, np.ndarray):
+                value.setflags(write=False)
+            object.__setattr__(self, key, value)
+        object.__setattr__(self, "kernel", pack(self))
+
+    def __dask_tokenize__(self) -> str:
+        """A hash of the content: equal models give equal Dask keys, so a model passed to many
+        tasks is sent to each worker once (``robodyn.distributed``)."""
+        import hashlib
+        import pickle
+
+        return hashlib.sha256(pickle.dumps(self.__getstate__(), protocol=5)).hexdigest()
+
     # -- derived quantities ------------------------------------------------------------
     @property
     def nbodies(self) -> int:

@@ -15,6 +15,7 @@ import numpy as np
 from .._jit import inline
 from ..layout import BODY_COLUMNS, DOF_COLUMNS, IQ, IV, JTYPE, NDOF, PARAMS_SIZE
 from ..joints import NQ
+from ._lazy import is_lazy
 from ._workspace import view
 
 
@@ -41,6 +42,9 @@ def unpack(ints, packed):
 def _as_float(name: str, x) -> np.ndarray:
     if type(x) is np.ndarray and x.dtype == np.float64:
         return x
+    if is_lazy(x):  # never computed behind the caller's back
+        raise TypeError(f"{name}: a Dask array, which this function does not take: pass the states as Dask "
+                        f"arrays (the batched functions then return Dask arrays) or call .compute() first")
     try:
         return np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):

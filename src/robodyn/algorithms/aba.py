@@ -42,6 +42,7 @@ from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
                        momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
                        wrench_to_aligned)
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -578,6 +579,8 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
                 return qdd
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
+    if any_lazy(q, v, tau, f_ext):
+        return deferred(aba, locals())
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]

@@ -25,6 +25,7 @@ from numba import boolean
 
 from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from . import rnea as _rnea
 from . import minv as _minv
@@ -151,6 +152,8 @@ def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, frict
     Raises ValueError when a body's articulated inertia is singular, as :func:`robodyn.aba`.
     Reference: Carpentier and Mansard, RSS 2018.
     """
+    if any_lazy(q, v, tau, f_ext):
+        return deferred(aba_derivatives, locals())
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba_derivatives()")
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:

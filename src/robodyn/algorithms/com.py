@@ -14,6 +14,7 @@ import numpy as np
 
 from .._jit import core, inline, kernel
 from ..layout import IV, NDOF, PARENT
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .crba import world_inertias
@@ -99,11 +100,15 @@ def _run(model, q, check_finite, with_jacobian, what):
 
 def center_of_mass(model, q, *, check_finite: bool = True) -> np.ndarray:
     """World position of the centre of mass of all bodies: (..., 3) for q (..., nq)."""
+    if any_lazy(q):
+        return deferred(center_of_mass, locals())
     batch, C, _ = _run(model, q, check_finite, False, "center_of_mass")
     return C[0] if batch == () else C.reshape(batch + (3,))
 
 
 def com_jacobian(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Jacobian of the centre of mass, (..., 3, nv): ``J_com v`` is its world-frame velocity."""
+    if any_lazy(q):
+        return deferred(com_jacobian, locals())
     batch, _, JC = _run(model, q, check_finite, True, "com_jacobian")
     return JC[0] if batch == () else JC.reshape(batch + JC.shape[1:])

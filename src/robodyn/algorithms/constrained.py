@@ -33,6 +33,7 @@ import numpy as np
 
 from .. import joints as Jt
 from ..lie import skew
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .crba import crba
 from .jacobian import jacobian_pass, moving_frame
@@ -302,6 +303,8 @@ def constraint_jacobian(model, q, v, constraints: Sequence) -> tuple[np.ndarray,
     """Stacked ``(J_c, Jdot_c v, phi)`` of ``constraints`` for one state ``q`` (nq,), ``v``
     (nv,) (then B = 1) or flat batches ``q`` (B, nq), ``v`` (B, nv): (B, m, nv), (B, m),
     (B, m) with ``m`` the sum of their dimensions."""
+    if any_lazy(q, v):
+        return deferred(constraint_jacobian, locals())
     B = _inputs.as_batch(q).shape[0]
     if not constraints:
         return np.zeros((B, 0, model.nv)), np.zeros((B, 0)), np.zeros((B, 0))
@@ -383,6 +386,8 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
     J. Baumgarte, "Stabilization of constraints and integrals of motion in dynamical
     systems", Comput. Methods Appl. Mech. Eng. 1 (1972).
     """
+    if any_lazy(q, v, tau):
+        return deferred(constrained_dynamics, locals())
     constraints = _check_constraints(constraints)
     alpha, beta = _check_baumgarte(baumgarte)
     if not (np.isfinite(rcond) and 0 <= rcond < 1):

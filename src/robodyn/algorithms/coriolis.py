@@ -27,6 +27,7 @@ from numba import boolean
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .crba import world_state
@@ -184,6 +185,8 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray |
             return C
     except TypeError:  # not contiguous float64 arrays
         pass
+    if any_lazy(q, v):
+        return deferred(coriolis_matrix, locals())
     batch, x = _inputs.states(model, q=q, v=v)
     return _run(model, batch, x, check_finite, "coriolis_matrix", out)[1]
 
@@ -198,6 +201,8 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     joint; ``Gamma`` is then still defined by ``C(q, e_k)`` and satisfies ``C = Gamma v``, but
     it is not symmetric in ``j, k`` for those directions.
     """
+    if any_lazy(q):
+        return deferred(christoffel_symbols, locals())
     batch, x = _inputs.states(model, q=q)
     nv = model.nv
     Q = np.repeat(_inputs.as_batch(x["q"]), nv, axis=0)

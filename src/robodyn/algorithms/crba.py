@@ -19,6 +19,7 @@ from numba import boolean
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
@@ -149,6 +150,8 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
             return M
     except (TypeError, KeyError):  # not contiguous float64 arrays (or armature not bool)
         pass
+    if any_lazy(q):
+        return deferred(crba, locals())
     batch, x = _inputs.states(model, q=q)
     dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)

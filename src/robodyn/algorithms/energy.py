@@ -14,6 +14,7 @@ import numpy as np
 from .._jit import core, inline, kernel
 from ..layout import INERTIA, INERTIA_END
 from ..spatial import dot6, inertia_mul
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .status import OK, finite, result_status
@@ -79,11 +80,15 @@ def _run(model, check_finite, what, **arrays):
 
 def kinetic_energy(model, q, v, *, check_finite: bool = True):
     """Kinetic energy ``v^T M(q) v / 2`` of the rigid bodies: (...,) for q (..., nq), v (..., nv)."""
+    if any_lazy(q, v):
+        return deferred(kinetic_energy, locals())
     batch, OUT = _run(model, check_finite, "kinetic_energy", q=q, v=v)
     return OUT[:, 0].reshape(batch)[()]
 
 
 def potential_energy(model, q, *, check_finite: bool = True):
     """Gravitational potential energy ``-sum_i m_i g . c_i``: (...,) for q (..., nq)."""
+    if any_lazy(q):
+        return deferred(potential_energy, locals())
     batch, OUT = _run(model, check_finite, "potential_energy", q=q)
     return OUT[:, 1].reshape(batch)[()]

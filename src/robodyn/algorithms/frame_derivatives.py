@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..layout import NDOF
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .jacobian import FRAMES, jacobian_pass, moving_frame
 
@@ -119,6 +120,8 @@ def frame_velocity_derivatives(model, q, v, body, frame: str = "world", *,
     """``(dV/dq, dV/dv)`` (..., 6, nv) of the velocity ``V = J(q) v`` of a body or frame
     (:func:`robodyn.jacobian` with the same ``body`` and ``frame``); ``dV/dv = J``, ``q``
     in the tangent space of :func:`robodyn.integrate` (see the module docstring)."""
+    if any_lazy(q, v):
+        return deferred(frame_velocity_derivatives, locals())
     b, Rbf, pbf, batch, x = _setup(model, body, frame, q=q, v=v)
     Jc, V, _, dV, _, _, OR, OP = _world(model, x, b, "frame_velocity_derivatives", check_finite)
     Rf, pf = OR @ Rbf, OP + OR @ pbf
@@ -136,6 +139,8 @@ def frame_acceleration_derivatives(model, q, v, a, body, frame: str = "world", *
     of a body or frame (:func:`robodyn.jacobian` and :func:`robodyn.jacobian_dot_times_v` with
     the same ``body`` and ``frame``: spatial for ``"world"``/``"local"``, classical for
     ``"local_world_aligned"``); ``dA/da = J`` (see the module docstring)."""
+    if any_lazy(q, v, a):
+        return deferred(frame_acceleration_derivatives, locals())
     b, Rbf, pbf, batch, x = _setup(model, body, frame, q=q, v=v, a=a)
     Jc, V, A, dV, dAq, dAv, OR, OP = _world(model, x, b, "frame_acceleration_derivatives", check_finite)
     Rf, pf = OR @ Rbf, OP + OR @ pbf

@@ -28,6 +28,7 @@ import numpy as np
 from .._deprecated import renamed_keyword
 from .._jit import inline, kernel
 from .. import joints as J
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .status import OK
@@ -113,6 +114,8 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, fra
         if _hybrid_single(k.ints, k.body, dofs, params, q, v, a_known, tau_known, known, k.zero_wrench,
                           -1, check_finite, a, tau) == OK:
             return a, tau
+    if any_lazy(q, v, a_known, tau_known, f_ext):
+        return deferred(hybrid_dynamics, locals())
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,

@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import joints as J
 from ..lie import exp_se3, inverse_adjoint, log_se3, quat_matrix, quat_mul, right_jacobian_se3
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import require_finite_result
 
@@ -93,6 +94,8 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
         q, v)) == v`` for rotations below pi.
     Reference: Lynch and Park, *Modern Robotics*, eq. (3.88).
     """
+    if any_lazy(q, v):
+        return deferred(integrate, locals())
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
     check_configurations(model, check_finite, "integrate", q=q, v=v)
@@ -118,6 +121,8 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
     in the frame of ``q0``'s base, rotation part of norm at most pi. Equals Pinocchio's
     ``difference(model, q0, q1)``. Reference: Lynch and Park, *Modern Robotics*, sec. 3.3.3.
     """
+    if any_lazy(q0, q1):
+        return deferred(difference, locals())
     return _difference(model, q0, q1, check_finite, "difference")
 
 
@@ -152,6 +157,8 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     right Jacobian of SE(3) (:func:`robodyn.lie.right_jacobian_se3`). Reference: Sola, Deray
     and Atchuthan, "A micro Lie theory for state estimation in robotics" (2018), eqs. (68)-(69).
     """
+    if any_lazy(q, v):
+        return deferred(integrate_jacobians, locals())
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
     check_configurations(model, check_finite, "integrate_jacobians", q=q, v=v)
@@ -174,6 +181,8 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
     1-dof joints: ``-1`` and ``1``. A free joint: ``J_1 = Jr(d)^-1`` and ``J_0 = -Jr(-d)^-1``
     (the inverse left Jacobian). Reference: Sola et al. (2018), eqs. (75)-(76) and (79).
     """
+    if any_lazy(q0, q1):
+        return deferred(difference_jacobians, locals())
     d = _difference(model, q0, q1, check_finite, "difference_jacobians")
     J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
     J0 = -J1

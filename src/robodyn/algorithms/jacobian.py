@@ -21,6 +21,7 @@ import numpy as np
 from .._jit import core, inline, kernel
 from ..layout import IV, MOTION, NDOF, PARENT
 from ..spatial import motion_act
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .status import OK, finite, finite2, result_status
@@ -119,6 +120,8 @@ def jacobian(model, q, body, frame: str = "world", *, check_finite: bool = True)
     ``"local_world_aligned"`` (module docstring). ``J v`` is the frame's velocity and
     ``J^T [f; n]`` the joint forces balancing a wrench ``[f; n]`` in the same coordinates.
     """
+    if any_lazy(q):
+        return deferred(jacobian, locals())
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
     b, Rbf, pbf = moving_frame(model, body)
@@ -145,6 +148,8 @@ def jacobian_dot_times_v(model, q, v, body, frame: str = "world", *, check_finit
     """``Jdot(q, v) v`` (..., 6), rows ``[linear; angular]``, for the Jacobian of
     :func:`jacobian` with the same ``body`` and ``frame``: the frame's acceleration when
     ``qdd = 0``, so that its acceleration is ``J qdd + Jdot v``."""
+    if any_lazy(q, v):
+        return deferred(jacobian_dot_times_v, locals())
     if frame not in FRAMES:
         raise ValueError(f"frame must be one of {FRAMES}, got {frame!r}")
     b, Rbf, pbf = moving_frame(model, body)

@@ -16,6 +16,7 @@ from .._jit import inline, kernel
 from ..layout import IQ, IV, JTYPE, MOTION, NDOF, PARENT, UNIT_AXIS
 from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .status import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
@@ -139,6 +140,8 @@ def forward_kinematics(model, q, *, check_finite: bool = True) -> np.ndarray:
     q: (..., nq). Returns (..., nbodies, 4, 4): ``T[..., i, :, :]`` maps body-``i``
     coordinates to world coordinates (rotation block and origin position).
     """
+    if any_lazy(q):
+        return deferred(forward_kinematics, locals())
     batch, x = _inputs.states(model, q=q)
     oR, op = world_poses(model, x["q"], batch, check_finite, "forward_kinematics")
     return _inputs.unflatten(_homogeneous(oR, op), batch)
@@ -156,6 +159,8 @@ def frame_placement(model, oR: np.ndarray, op: np.ndarray, name: str) -> tuple[n
 
 def frame_pose(model, q, name: str, *, check_finite: bool = True) -> np.ndarray:
     """World pose (..., 4, 4) of a link or frame (a body, or a link merged into one)."""
+    if any_lazy(q):
+        return deferred(frame_pose, locals())
     batch, x = _inputs.states(model, q=q)
     oR, op = world_poses(model, x["q"], batch, check_finite, "frame_pose")
     R, p = frame_placement(model, oR, op, name)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import inertia_about_origin
+from ._lazy import any_lazy, deferred
 from .jacobian import jacobian
 
 
@@ -31,6 +32,8 @@ def spatial_inertia(theta) -> np.ndarray:
 def mass_matrix_from_jacobians(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """``sum_i J_i^T M_i J_i`` (..., nv, nv) over the bodies (module docstring), plus the
     joints' ``armature`` on the diagonal (as :func:`robodyn.crba`)."""
+    if any_lazy(q):
+        return deferred(mass_matrix_from_jacobians, locals())
     q = np.asarray(q, dtype=float)
     M = 0.0
     for i in range(model.nbodies):

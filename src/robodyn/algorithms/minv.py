@@ -39,6 +39,7 @@ from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_
 from ..joint_kernels import local_placement
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
 from ._inputs import nq_of
@@ -250,6 +251,8 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
         Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
         if _minv_single(k.ints, k.body, dofs, q, check_finite, Minv) == OK:
             return Minv
+    if any_lazy(q):
+        return deferred(inverse_mass_matrix, locals())
     batch, x = _inputs.states(model, q=q)
     q = x["q"]
     if batch == ():

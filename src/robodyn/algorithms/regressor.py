@@ -46,6 +46,7 @@ from .._deprecated import renamed_keywords
 from .._jit import core, inline, kernel
 from ..layout import IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .status import NONFINITE, OK, finite, finite2, result_status
@@ -341,6 +342,8 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, a
 
     Reference: Khalil and Dombre (2002), section 12.3; Atkeson, An and Hollerbach (1986).
     """
+    if any_lazy(q, v, a):
+        return deferred(regressor, locals())
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     k = model.kernel
     flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
@@ -397,6 +400,8 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
     1987; Niemeyer and Slotine, "Performance in adaptive manipulator control", IJRR 10(2),
     1991; Echeandia and Wensing, J. Comput. Nonlinear Dynam. 16(9), 2021.
     """
+    if any_lazy(q, v, v_ref, a_ref):
+        return deferred(slotine_li_regressor, locals())
     batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
     k = model.kernel
     flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
@@ -435,6 +440,8 @@ def kinetic_energy_regressor(model, q, v, *, check_finite: bool = True) -> np.nd
     """``Y_T`` (..., 10 nbodies) with ``Y_T @ model.inertial_parameters() ==
     kinetic_energy(model, q, v)``: ``T = sum_i 1/2 V_i . I(theta_i) V_i`` (body twists
     ``V_i`` in body frames; armature not included, as in ``kinetic_energy``)."""
+    if any_lazy(q, v):
+        return deferred(kinetic_energy_regressor, locals())
     return _energy(model, check_finite, "kinetic_energy_regressor", q=q, v=v)[..., 0, :]
 
 
@@ -442,4 +449,6 @@ def potential_energy_regressor(model, q, *, check_finite: bool = True) -> np.nda
     """``Y_U`` (..., 10 nbodies) with ``Y_U @ model.inertial_parameters() ==
     potential_energy(model, q)``: ``U = -g . sum_i (m_i p_i + R_i h_i)`` (world pose
     ``(R_i, p_i)`` of body ``i``), so only the mass and first-moment columns are non-zero."""
+    if any_lazy(q):
+        return deferred(potential_energy_regressor, locals())
     return _energy(model, check_finite, "potential_energy_regressor", q=q)[..., 1, :]

@@ -25,6 +25,7 @@ from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOT
 from ..joint_kernels import body_placement, friction_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -269,6 +270,8 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
                 return tau
         except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
             pass
+    if any_lazy(q, v, a, f_ext):
+        return deferred(rnea, locals())
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)

@@ -58,6 +58,7 @@ from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kerne
 from ..layout import ARMATURE, COULOMB, DAMPING, IV, NDOF, PARENT, SMOOTHING, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
                        motion_cross, wrench_to_local)
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from ._inputs import fits, nq_of, unpack
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
@@ -397,6 +398,8 @@ def rnea_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *, fricti
     Reference: J. Carpentier and N. Mansard, "Analytical derivatives of rigid body dynamics
     algorithms", RSS 2018 (the recursions are in ``robodyn/algorithms/rnea_derivatives.py``).
     """
+    if any_lazy(q, v, a, f_ext):
+        return deferred(rnea_derivatives, locals())
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea_derivatives()")
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:

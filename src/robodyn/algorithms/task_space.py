@@ -30,6 +30,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .jacobian import FRAMES, jacobian, jacobian_dot_times_v
 from .minv import inverse_mass_matrix
@@ -106,6 +107,8 @@ def task_space_inertia(model, q, body, frame: str = "local_world_aligned", rows=
     vz; m = its length). Raises ValueError where ``J M^-1 J^T`` is singular.
     Reference: Khatib 1987.
     """
+    if any_lazy(q):
+        return deferred(task_space_inertia, locals())
     batch, _, _, _, Lam = _task(model, q, body, frame, rows, armature, check_finite, "task_space_inertia")
     return Lam[0] if batch == () else Lam.reshape(batch + Lam.shape[1:])
 
@@ -115,6 +118,8 @@ def dynamically_consistent_inverse(model, q, body, frame: str = "local_world_ali
     """Dynamically consistent generalised inverse ``Jbar = M^-1 J^T Lambda`` (..., nv, m) of
     the task Jacobian (arguments as in :func:`task_space_inertia`): ``J Jbar = 1``.
     Reference: Khatib 1987."""
+    if any_lazy(q):
+        return deferred(dynamically_consistent_inverse, locals())
     batch, _, Minv, J, Lam = _task(model, q, body, frame, rows, armature, check_finite,
                                    "dynamically_consistent_inverse")
     Jbar = Minv @ np.swapaxes(J, 1, 2) @ Lam
@@ -132,6 +137,8 @@ def task_space_dynamics(model, q, v, body, frame: str = "local_world_aligned", r
     with ``Lambda x'' + mu + p = F``. Reference: Khatib 1987; Siciliano et
     al. 2009, section 7.8.
     """
+    if any_lazy(q, v):
+        return deferred(task_space_dynamics, locals())
     batch, x = _inputs.states(model, q=q, v=v)
     if check_finite and not np.all(np.isfinite(x["v"])):
         raise ValueError("task_space_dynamics: v contains NaN or Inf")

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._lazy import any_lazy, deferred
 from . import _inputs
 from .rnea import run as _rnea_run
 from .rnea_derivatives import run as _derivatives_run
@@ -32,16 +33,22 @@ def _rnea_term(model, what, check_finite, gravity, armature, given, roles, run=_
 
 def gravity(model, q, *, check_finite: bool = True) -> np.ndarray:
     """Generalised gravity ``g(q)`` (..., nv): the joint forces that hold the robot still."""
+    if any_lazy(q):
+        return deferred(gravity, locals())
     return _rnea_term(model, "gravity", check_finite, True, False, {"q": q}, {"v": None, "a": None})
 
 
 def nonlinear_effects(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """``C(q, v) v + g(q)`` (..., nv), the Coriolis, centrifugal and gravity forces."""
+    if any_lazy(q, v):
+        return deferred(nonlinear_effects, locals())
     return _rnea_term(model, "nonlinear_effects", check_finite, True, False, {"q": q, "v": v}, {"v": "v", "a": None})
 
 
 def generalized_momentum(model, q, v, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
     """Generalised momentum ``M(q) v`` (..., nv), O(n) (``armature`` as in :func:`robodyn.crba`)."""
+    if any_lazy(q, v):
+        return deferred(generalized_momentum, locals())
     return _rnea_term(model, "generalized_momentum", check_finite, False, armature, {"q": q, "v": v},
                       {"v": None, "a": "v"})
 
@@ -49,12 +56,16 @@ def generalized_momentum(model, q, v, *, armature: bool = True, check_finite: bo
 def gravity_derivatives(model, q, *, check_finite: bool = True) -> np.ndarray:
     """``dg/dq`` (..., nv, nv) of :func:`robodyn.gravity` (Pinocchio's
     ``computeGeneralizedGravityDerivatives``)."""
+    if any_lazy(q):
+        return deferred(gravity_derivatives, locals())
     return _rnea_term(model, "gravity_derivatives", check_finite, True, False, {"q": q}, {"v": None, "a": None},
                       _derivatives_run, mass=False)[0]
 
 
 def nonlinear_effects_derivatives(model, q, v, *, check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """``(d/dq, d/dv)`` (..., nv, nv) of ``C(q, v) v + g(q)`` (:func:`robodyn.nonlinear_effects`)."""
+    if any_lazy(q, v):
+        return deferred(nonlinear_effects_derivatives, locals())
     return _rnea_term(model, "nonlinear_effects_derivatives", check_finite, True, False, {"q": q, "v": v},
                       {"v": "v", "a": None}, _derivatives_run, mass=False)[:2]
 
@@ -63,6 +74,8 @@ def generalized_momentum_derivatives(model, q, v, *, armature: bool = True,
                                      check_finite: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """``(d(M v)/dq, M)`` (..., nv, nv) of :func:`robodyn.generalized_momentum` (``d(M v)/dv =
     M``, with the armature when ``armature``)."""
+    if any_lazy(q, v):
+        return deferred(generalized_momentum_derivatives, locals())
     dq, _, M = _rnea_term(model, "generalized_momentum_derivatives", check_finite, False, armature,
                           {"q": q, "v": v}, {"v": None, "a": "v"}, _derivatives_run)
     return dq, M
