@@ -37,7 +37,8 @@ _LAZY = {
 _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize": "simulation",
               "rollout": "simulation", "Rollouts": "simulation", "simulation": None,
               "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
-              "contact": None, "Contacts": "contact", "inertia": None, "actuators": None}
+              "contact": None, "Contacts": "contact", "inertia": None, "actuators": None,
+              "distributed": None, "simulate_many": "distributed"}
 
 
 def __getattr__(name):
@@ -81,7 +82,7 @@ __all__ = [
     "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
     "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",
-    "contact", "Contacts", "rollout", "Rollouts",
+    "contact", "Contacts", "rollout", "Rollouts", "distributed", "simulate_many",
 ]
 # ``rd.symbolic`` (closed-form models, imports sympy) is loaded on first use and left out of
 # ``__all__`` so that ``from robodyn import *`` stays light.

@@ -134,14 +134,22 @@ def steps():
     return out
 
 
-def warmup(progress=None) -> None:
+def warmup(progress=None, only=None) -> None:
     """Compile or load every kernel: each public algorithm (single and batched calls, fixed and
     floating base) and the simulation kernels.
 
     ``progress``: None (silent), or a callable ``progress(done, total, name)`` called before
     each step and once at the end (``name`` empty), e.g. to draw a progress bar.
+    ``only``: None (everything), or the names of the functions to compile (``["rnea",
+    "aba"]``: their steps alone, e.g. on the workers of a cluster that run only those).
     """
     todo = steps()
+    if only is not None:
+        only = {only} if isinstance(only, str) else set(only)
+        unknown = only - {name.split(" ")[0] for name, _ in todo}
+        if unknown:
+            raise ValueError(f"only: no warm-up step for {sorted(unknown)}")
+        todo = [(name, call) for name, call in todo if name.split(" ")[0] in only]
     for k, (name, call) in enumerate(todo):
         if progress is not None:
             progress(k, len(todo), name)
