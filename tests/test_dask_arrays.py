@@ -105,3 +105,20 @@ def test_bad_calls_are_refused():
 
     with pytest.raises(TypeError, match="Dask array"):  # a function without the dispatch never computes
         _inputs.states(MODEL, q=_lazy(Q))
+
+
+def test_without_dask_nothing_changes():
+    """``import robodyn`` and the in-memory calls never import Dask; asking for a part that
+    needs it names the extra to install."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, robodyn as rd\n"
+            "m = rd.models.load('panda'); rd.rnea(m, np.zeros((3, 7)), np.zeros(7), np.zeros(7))\n"
+            "rd.simulate_many(m, np.zeros(7), np.zeros(7), 0.002, 1e-3, runs=2)\n"
+            "assert not [k for k in sys.modules if k.split('.')[0] in ('dask', 'distributed')], 'dask imported'\n"
+            "sys.modules['distributed'] = None\n"
+            "try:\n    rd.distributed.Warmup\nexcept ImportError as e:\n    print(e)\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert 'pip install "robodyn[dask]"' in out.stdout

@@ -121,3 +121,11 @@ def test_warmup_only_names_known_functions():
     done = []
     rd.warmup(progress=lambda k, n, name: done.append(name), only="crba")
     assert done[-1] == "" and {n.split(" ")[0] for n in done[:-1]} == {"crba"} and len(done) == 5
+
+
+def test_simulate_many_shows_progress_on_the_cluster(client, capsys):
+    r = simulate_many(PANDA, Q0, np.zeros(7), 0.01, 1e-3, _controller(), runs=4, chunk=1, client=client,
+                      progress=True)
+    assert np.isfinite(r.q_final).all()
+    shown = capsys.readouterr()
+    assert "100%" in shown.out + shown.err
