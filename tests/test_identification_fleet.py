@@ -118,8 +118,10 @@ def test_reduced_statistics_give_the_textbook_estimates():
 
 def test_split_logs_combine_to_the_whole():
     """A log split in 3 parts reduced with uneven blocks (13, 1 and 4096 samples) and combined,
-    in two orders: the same factor (nonnegative diagonal: unique) and the same OLS, WLS and
-    physically consistent estimates as the whole log, to 1e-10."""
+    in two orders: the same information ``R_j^T R_j = [W_j y_j]^T [W_j y_j]`` per joint (a
+    joint's own rows are rank deficient, so its factor is not unique), the same factor of all
+    rows stacked (of full rank: unique with its nonnegative diagonal), and the same OLS, WLS
+    and physically consistent estimates as the whole log, to 1e-10."""
     model, _, base = robot()
     log = simulated(2, 4.0)
     whole = Reduced.from_log(model, base, log)
@@ -128,21 +130,30 @@ def test_split_logs_combine_to_the_whole():
              Reduced.from_log(model, base, log.rows(slice(260, None)), block=4096)]
     for combined in (parts[0] + parts[1] + parts[2], parts[2].combine(parts[1].combine(parts[0]))):
         assert combined.samples == len(log)
-        assert_close(combined.R, whole.R, 1e-12, "R")
+        gram = lambda x: x.R.transpose(0, 2, 1) @ x.R  # noqa: E731
+        assert_close(gram(combined), gram(whole), 1e-12, "R_j^T R_j")
+        assert_close(combined.stacked(), whole.stacked(), 1e-12, "stacked factor")
         assert_same_estimate(ols(combined), ols(whole), what="ols")
         assert_same_estimate(wls(combined), wls(whole), what="wls")
     prior = nominal_parameters(model, base)
     a, b = physical(model, base, combined, prior), physical(model, base, whole, prior)
     assert_same_estimate(a, b, what="physical")
     assert_close(a.theta, b.theta, 1e-10, "physical theta")
+    # identify takes reduced statistics as they are
+    result = ident.identify(model, combined, method="wls", base=base)
+    assert result.samples == len(log)
+    assert_same_estimate(result.estimate, wls(whole), what="identify of Reduced")
+    with pytest.raises(ValueError, match=r"reduced statistics of \(nv, r\) = \(4, 15\); the model and its base "
+                                         r"parameters have \(4, 16\)"):
+        ident.identify(model, Reduced.empty(4, 15), base=base)
     # the empty statistics are neutral; statistics of other sizes do not combine
-    assert_close((whole + Reduced.empty(model.nv, base.count)).R, whole.R, 1e-15)
+    assert_close((whole + Reduced.empty(model.nv, base.count)).stacked(), whole.stacked(), 1e-15)
     with pytest.raises(ValueError, match=r"different sizes \(nv, r\) = \(4, 16\) and \(4, 15\)"):
         whole + Reduced.empty(4, 15)
     with pytest.raises(ValueError, match="block: expected a positive integer, got 0"):
         Reduced.from_log(model, base, log, block=0)
     with pytest.raises(TypeError, match="expected Reduced statistics"):
-        physical(model, base, *stack(model, base, log), prior)
+        physical(model, base, stack(model, base, log)[0], prior)
 
 
 @pytest.mark.parametrize("method", METHODS)
@@ -270,10 +281,14 @@ def test_cluster_identification_equals_the_local_one(client, fleet_files, method
     1e-10; a Dask DataFrame of the same files (one partition each), computed on the cluster,
     too; a missing file among them is named in the error raised here."""
     import dask.dataframe as dd
+    from distributed import get_task_stream
 
     model, _, base = robot()
     local = ident.identify(model, fleet_files, method=method, base=base)
-    remote = ident.identify(model, fleet_files, method=method, base=base, client=client)
+    with get_task_stream(client) as stream:
+        remote = ident.identify(model, fleet_files, method=method, base=base, client=client)
+    names = [str(task["key"]).split("-")[0] for task in stream.data]
+    assert (names.count("_reduce_labelled"), names.count("combine")) == (5, 4)  # a log per task, a binary tree
     assert remote.samples == local.samples
     assert_same_estimate(remote.estimate, local.estimate, what=f"{method} on the cluster")
     frame = dd.read_csv([str(p) for p in fleet_files], blocksize=None)

@@ -11,10 +11,14 @@
     result = ident.identify(model, log, method="physical", base=base)
     rd.write_urdf(result.identified_model(), "identified.urdf")
     ident.write_report(result, log, "report/")
+    fleet = ident.identify(model, ["robot1.csv", "robot2.parquet"], preprocess={"cutoff": 10}, base=base,
+                           client=None)                                # or a dask.distributed.Client
 
 Modules: :mod:`.base` (base parameters, ``K``, names), :mod:`.excitation` (Fourier series
 and their optimisation), :mod:`.data` (CSV logs, filtering, differentiation, decimation),
-:mod:`.estimation` (OLS, WLS, physically consistent), :mod:`.identify` (the pipeline),
+:mod:`.reduced` (the samples reduced to a triangular factor per joint, combinable),
+:mod:`.estimation` (OLS, WLS, physically consistent, from the reduced statistics),
+:mod:`.fleet` (many logs, optionally on Dask workers), :mod:`.identify` (the pipeline),
 :mod:`.report` (text and plots), :mod:`.cli` (the ``excite`` and ``identify`` commands). The
 regressors themselves are :func:`robodyn.regressor` and the energy regressors.
 """
@@ -22,6 +26,8 @@ regressors themselves are :func:`robodyn.regressor` and the energy regressors.
 from .base import BaseParameters, base_parameters, parameter_names
 from .data import Log, preprocess, read_log, write_log
 from .estimation import Estimate, ols, physical, wls
+from .fleet import reduce_logs
+from .reduced import Reduced
 from .excitation import (FourierTrajectory, condition_number, feasible_trajectory, limits_of, optimize_excitation,
                          write_excitation)
 from .identify import Identification, identify
@@ -29,6 +35,7 @@ from .report import write_report
 
 __all__ = [
     "BaseParameters", "base_parameters", "parameter_names", "Log", "preprocess", "read_log", "write_log",
-    "Estimate", "ols", "physical", "wls", "FourierTrajectory", "condition_number", "feasible_trajectory", "limits_of",
-    "optimize_excitation", "write_excitation", "Identification", "identify", "write_report",
+    "Estimate", "ols", "physical", "wls", "Reduced", "reduce_logs", "FourierTrajectory", "condition_number",
+    "feasible_trajectory", "limits_of", "optimize_excitation", "write_excitation", "Identification", "identify",
+    "write_report",
 ]

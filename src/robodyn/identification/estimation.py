@@ -1,13 +1,14 @@
 """Estimation of the base parameters from measured torques.
 
 With the base regressor stacked over the samples, ``W beta = y + noise`` (``y`` the measured
-joint torques, ``beta = K theta`` the base parameters, friction columns included):
+joint torques, ``beta = K theta`` the base parameters, friction columns included; ``n = N nv``
+equations for ``r`` parameters):
 
-* ``ols``: ordinary least squares ``beta = W^+ y``, with ``cov = s^2 (W^T W)^-1`` and
-  ``s^2 = |y - W beta|^2 / (N - r)``;
+* ``ols``: ordinary least squares ``beta = W^+ y``, with ``cov = s^2 (W^T W)^+`` and
+  ``s^2 = |y - W beta|^2 / (n - r)``; per joint ``sigma_j^2 = |y_j - W_j beta|^2 / (N - r / nv)``;
 * ``wls``: weighted least squares with one standard deviation per joint estimated from the
   residuals of that joint (OLS first, then reweighted) (Gautier, "Dynamic identification of robots with power model",
-  ICRA 1997; Khalil and Dombre 2002, section 12.5), ``cov = (W^T S^-1 W)^-1``;
+  ICRA 1997; Khalil and Dombre 2002, section 12.5), ``cov = (W^T S^-1 W)^+``;
 * ``physical``: the standard parameters ``theta(x)`` of physically consistent bodies, with
   each body's 4 x 4 pseudo-inertia ``J = [[Sigma, h], [h^T, m]]`` (``Sigma = tr(I)/2 1 - I``)
   written as ``J = U U^T``, ``U`` upper triangular with exponentiated diagonal (the
@@ -18,6 +19,13 @@ joint torques, ``beta = K theta`` the base parameters, friction columns included
   triangular factor of ``[W y]`` (``r`` rows whatever the number of samples); ``P = 1 - K^+ K``
   projects on the unobservable directions, so the prior (the nominal model) only fixes what
   the torques cannot tell and does not bias the base parameters.
+
+All three work on the reduced statistics of the samples (:class:`.reduced.Reduced`: the
+triangular factor ``R_j`` of ``[W_j y_j]`` per joint, of any number of logs combined), never on
+``W`` itself: with ``[R_w z; 0 rho]`` the triangular factor of the stacked (and, for WLS,
+weighted) ``[R_1; ...; R_nv]``, ``beta`` solves ``R_w beta = z`` (``numpy.linalg.lstsq``:
+the minimum-norm solution, as for ``W``, when the columns are dependent), ``W^T S W = R_w^T
+R_w`` and the residual of joint ``j`` is ``|R_j [beta; -1]|^2`` (exact, not an approximation).
 """
 
 from __future__ import annotations
@@ -28,7 +36,7 @@ import numpy as np
 
 from ._blas import one_blas_thread
 from .base import BaseParameters
-from .data import Log
+from .reduced import Reduced
 
 
 @dataclass(frozen=True)
@@ -50,47 +58,65 @@ class Estimate:
             return 100.0 * self.std / np.abs(self.beta)
 
 
-def stack(model, base: BaseParameters, log: Log):
-    """``(W, y)``: the base regressor (N nv, r) and the torques (N nv,) of a log whose
-    ``v``, ``a`` and ``tau`` are known (see ``data.preprocess``)."""
-    if log.v is None or log.a is None or log.tau is None:
-        raise ValueError("the log needs velocities, accelerations and torques; run preprocess() first")
-    W = base.regressor(model, log.q, log.v, log.a)
-    return W.reshape(-1, base.count), log.tau.reshape(-1)
+def _as_reduced(stats, y, nv) -> Reduced:
+    """``stats`` itself, or the reduced statistics of a stacked regressor ``stats`` with ``y``, ``nv``."""
+    if isinstance(stats, Reduced):
+        if y is not None or nv is not None:
+            raise TypeError("y and nv go with a stacked regressor W, not with reduced statistics")
+        return stats
+    if y is None or nv is None:
+        raise TypeError(f"expected Reduced statistics, or a stacked regressor W with y and nv; got "
+                        f"{type(stats).__name__}{'' if y is None else ' and y'}{'' if nv is None else ' and nv'}")
+    return Reduced.from_rows(stats, y, nv)
 
 
-def _cov_std(W, weights_sq, s2=1.0):
-    A = W.T @ (W * weights_sq[:, None])
-    return np.sqrt(np.maximum(np.diag(np.linalg.pinv(A)) * s2, 0.0))
+def _fit(stats: Reduced, scale=None):
+    """``(beta, F)``: the least-squares ``beta`` of the rows of joint ``j`` weighted by ``scale[j]``
+    (minimum norm when rank deficient) and ``F`` (r + 1, r + 1), the triangular factor of the
+    weighted stacked ``[W y]`` (``beta`` solves ``F[:r, :r] beta = F[:r, r]``)."""
+    F = stats.stacked(scale)
+    r = stats.count
+    return np.linalg.lstsq(F[:r, :r], F[:r, r], rcond=None)[0], F
 
 
-def ols(W, y, nv: int) -> Estimate:
-    """Ordinary least squares (module docstring)."""
-    n, r = W.shape
+def _cov_std(Rw, s2=1.0):
+    """``sqrt(diag((R_w^T R_w)^+) s2)``: standard deviations of ``cov = s2 (W^T S W)^+``."""
+    return np.sqrt(np.maximum(np.diag(np.linalg.pinv(Rw.T @ Rw)) * s2, 0.0))
+
+
+def _sigma(stats: Reduced, res) -> np.ndarray:
+    """Residual standard deviation per joint, ``sqrt(res_j / max(N - r / nv, 1))``."""
+    return np.sqrt(res / max(stats.samples - stats.count / stats.nv, 1))
+
+
+def ols(stats, y=None, nv: int | None = None) -> Estimate:
+    """Ordinary least squares (module docstring) of reduced statistics ``stats``
+    (:class:`.reduced.Reduced`), or of a stacked regressor ``W`` (N nv, r) with torques ``y``
+    (N nv,) and ``nv`` (reduced first)."""
+    stats = _as_reduced(stats, y, nv)
+    n, r = stats.rows, stats.count
     if n <= r:
         raise ValueError(f"ols: {n} equations for {r} base parameters; record a longer log")
-    beta = np.linalg.lstsq(W, y, rcond=None)[0]
-    res = y - W @ beta
-    s2 = float(res @ res) / (n - r)
-    std = _cov_std(W, np.ones(n), s2)
-    sigma = np.sqrt((res.reshape(-1, nv) ** 2).sum(axis=0) / max(n // nv - r / nv, 1))
-    return Estimate("ols", beta, std, sigma)
+    beta, F = _fit(stats)
+    res = stats.residuals(beta)
+    return Estimate("ols", beta, _cov_std(F[:r, :r], float(res.sum()) / (n - r)), _sigma(stats, res))
 
 
-def wls(W, y, nv: int, iterations: int = 10) -> Estimate:
-    """Weighted least squares, one weight ``1 / sigma_j`` per joint, the ``sigma_j`` estimated
-    from the residuals: first of OLS, then of the weighted estimate again until they change
-    by less than 1 % (iteratively reweighted, ``iterations`` at most)."""
-    est = ols(W, y, nv)
-    floor = 1e-12 * max(float(np.abs(y).max()), 1e-300)
-    rows = W.shape[0] // nv
+def wls(stats, y=None, nv: int | None = None, iterations: int = 10) -> Estimate:
+    """Weighted least squares, one weight ``1 / sigma_j`` per joint (the rows ``R_j / sigma_j``),
+    the ``sigma_j`` estimated from the residuals: first of OLS, then of the weighted estimate
+    again until they change by less than 1 % (iteratively reweighted, ``iterations`` at most).
+    ``sigma_j`` is kept above ``1e-12`` times the largest RMS joint torque (exact data).
+    Arguments as :func:`ols`."""
+    stats = _as_reduced(stats, y, nv)
+    est = ols(stats)
+    floor = 1e-12 * max(float(stats.torque_rms().max()), 1e-300)
+    r = stats.count
     for _ in range(iterations):
         sigma = np.maximum(est.sigma, floor)
-        w = np.tile(1.0 / sigma, rows)
-        beta = np.linalg.lstsq(W * w[:, None], y * w, rcond=None)[0]
-        res = (y - W @ beta).reshape(-1, nv)
-        new = np.sqrt((res ** 2).sum(axis=0) / max(rows - W.shape[1] / nv, 1))
-        est = Estimate("wls", beta, _cov_std(W, w ** 2), new)
+        beta, F = _fit(stats, 1.0 / sigma)
+        new = _sigma(stats, stats.residuals(beta))
+        est = Estimate("wls", beta, _cov_std(F[:r, :r]), new)
         if np.all(np.abs(new - sigma) <= 0.01 * sigma):
             break
     return est
@@ -172,9 +198,10 @@ def nearest_consistent(theta, eps: float = 1e-6) -> np.ndarray:
     return parameters_of_pseudo_inertia((V * np.maximum(lam, floor)) @ V.T)
 
 
-def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 1e-8, start=None,
+def physical(model, base: BaseParameters, stats: Reduced, prior, *, prior_weight: float = 1e-8, start=None,
              max_nfev: int = 200) -> Estimate:
-    """Physically consistent least squares (module docstring).
+    """Physically consistent least squares (module docstring) of reduced statistics ``stats``
+    (:class:`.reduced.Reduced`; ``Reduced.from_rows(W, y, nv)`` of a stacked regressor).
 
     ``prior`` (p,): standard parameters ``[theta, extra]`` the unobservable directions are
     drawn to (usually the nominal model); ``start``: initial standard parameters (default: the
@@ -186,20 +213,26 @@ def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 
     """
     from scipy.optimize import least_squares
 
+    if not isinstance(stats, Reduced):
+        raise TypeError(f"physical: expected Reduced statistics (Reduced.from_rows(W, y, nv) of a stacked "
+                        f"regressor), got {type(stats).__name__}")
+    r = base.count
+    if stats.count != r or stats.nv != model.nv:
+        raise ValueError(f"physical: reduced statistics of (nv, r) = ({stats.nv}, {stats.count}), the model and its "
+                         f"base parameters have ({model.nv}, {r})")
     nb, p = model.nbodies, base.K.shape[1]
     prior = np.asarray(prior, dtype=float)
     if prior.shape != (p,):
         raise ValueError(f"prior: expected shape ({p},), got {prior.shape}")
+    beta_ls, F = _fit(stats)
     if start is None:
-        start = base.completion(np.linalg.lstsq(W, y, rcond=None)[0], prior)
+        start = base.completion(beta_ls, prior)
         start[:10 * nb] = np.concatenate([nearest_consistent(start[10 * i:10 * i + 10]) for i in range(nb)])
     start = np.asarray(start, dtype=float)
     if start.shape != (p,):
         raise ValueError(f"start: expected shape ({p},), got {start.shape}")
     # |W beta - y|^2 = |R beta - z|^2 + const with [W y] = Q [[R, z], [0, rho]]: r rows, not N nv
-    Rz = np.linalg.qr(np.column_stack([W, y]), mode="r")
-    r = base.count
-    A, z = Rz[:r, :r] @ base.K, Rz[:r, r]
+    A, z = F[:r, :r] @ base.K, F[:r, r]
     reg = np.sqrt(prior_weight) * max(float(np.linalg.norm(A, axis=0).mean()), 1e-12)
     N = np.eye(p) - np.linalg.pinv(base.K) @ base.K  # projector on the unobservable directions
     x0 = np.concatenate([np.concatenate([log_cholesky(start[10 * i:10 * i + 10]) for i in range(nb)]),
@@ -235,8 +268,7 @@ def physical(model, base: BaseParameters, W, y, prior, *, prior_weight: float = 
                           xtol=1e-15, ftol=1e-15, gtol=1e-15).x
     theta = theta_of(x)
     beta = base.K @ theta
-    res = (y - W @ beta).reshape(-1, model.nv)
-    sigma = np.sqrt((res ** 2).sum(axis=0) / max(res.shape[0] - base.count / model.nv, 1))
-    s2 = float((res ** 2).sum()) / max(W.shape[0] - base.count, 1)
-    std = _cov_std(W, np.ones(W.shape[0]), s2)  # linearised: the least-squares covariance at the solution
-    return Estimate("physical", beta, std, sigma, theta)
+    res = stats.residuals(beta)
+    s2 = float(res.sum()) / max(stats.rows - r, 1)
+    std = _cov_std(F[:r, :r], s2)  # linearised: the least-squares covariance at the solution
+    return Estimate("physical", beta, std, _sigma(stats, res), theta)

@@ -2,8 +2,13 @@
 
     base = base_parameters(model, damping=True, coulomb=True)
     result = identify(model, preprocess(read_log("data.csv", model), cutoff=10), method="wls")
+    result = identify(model, ["a.csv", "b.csv"], preprocess={"cutoff": 10}, client=client)  # many logs
     result.predict(other_log)          # torques of another motion
     result.identified_model()          # a Model with the estimated parameters
+
+Every estimate is computed from the reduced statistics of the samples (:mod:`.reduced`: a
+triangular factor per joint, a block of samples at a time), of one log or of many combined
+(:mod:`.fleet`, optionally on Dask workers).
 """
 
 from __future__ import annotations
@@ -19,7 +24,9 @@ from ..errors import ModelError, RobodynWarning
 from ._blas import one_blas_thread
 from .base import BaseParameters, base_parameters
 from .data import Log
-from .estimation import Estimate, ols, physical, stack, wls
+from .estimation import Estimate, ols, physical, wls
+from .fleet import reduce_logs
+from .reduced import BLOCK
 
 METHODS = ("ols", "wls", "physical")
 
@@ -27,8 +34,10 @@ METHODS = ("ols", "wls", "physical")
 @dataclass(frozen=True)
 class Identification:
     """Result of :func:`identify`: the nominal ``model``, its ``base`` parameters, the
-    ``estimate``, the ``condition_number`` of the stacked base regressor, and the nominal
-    base parameters ``beta_nominal`` (K times the model's own parameters, offsets 0)."""
+    ``estimate``, the ``condition_number`` of the stacked base regressor, the nominal
+    base parameters ``beta_nominal`` (K times the model's own parameters, offsets 0), the
+    number of ``samples`` (of all logs) and the ``singular_values`` (r,) of the stacked base
+    regressor, largest first."""
 
     model: object
     base: BaseParameters
@@ -36,6 +45,7 @@ class Identification:
     condition_number: float
     beta_nominal: np.ndarray
     samples: int
+    singular_values: np.ndarray | None = None
 
     def predict(self, log: Log) -> np.ndarray:
         """Joint torques (N, nv) of the identified model along a log's motion."""
@@ -112,32 +122,47 @@ def nominal_parameters(model, base: BaseParameters) -> np.ndarray:
 
 
 @renamed_keywords(viscous="damping")
-def identify(model, log: Log, *, method: str = "ols", damping: bool = True, coulomb: bool = True,
+def identify(model, log, *, method: str = "ols", damping: bool = True, coulomb: bool = True,
              armature: bool = False, offset: bool = False, base: BaseParameters | None = None,
-             prior_weight: float = 1e-8) -> Identification:
-    """Identify the base parameters of ``model`` from a preprocessed log.
+             prior_weight: float = 1e-8, preprocess: dict | None = None, client=None,
+             block: int = BLOCK) -> Identification:
+    """Identify the base parameters of ``model`` from one log or many.
 
     Args:
-        log: samples with ``q``, ``v``, ``a`` and ``tau`` (``data.preprocess`` fills the
-            derivatives).
+        log: a :class:`Log` with ``q``, ``v``, ``a`` and ``tau`` (``data.preprocess`` fills the
+            derivatives) or the path of a log file; many logs as a list or tuple of those
+            (pandas DataFrames too), or a Dask DataFrame with one log per partition
+            (:mod:`.fleet`); or :class:`.reduced.Reduced` statistics of ``base``'s regressor.
         method: ``"ols"``, ``"wls"`` or ``"physical"`` (see :mod:`.estimation`).
         damping, coulomb, armature, offset: the extra columns identified with the inertial
             parameters (ignored when ``base`` is given: its own switches apply).
         base: precomputed base parameters (default :func:`base_parameters` of the model).
         prior_weight: weight of the nominal parameters in ``physical``.
+        preprocess: None (every log used as it is: it needs ``v`` and ``a``), or the keywords
+            of :func:`.data.preprocess` applied to every log, e.g. ``{"cutoff": 10}``
+            (``{}``: differentiation only).
+        client: a ``dask.distributed.Client``: the logs are read, preprocessed and reduced on
+            its workers, only their triangular factors sent back (:mod:`.fleet`).
+        block: samples whose regressor is computed at once (memory ``block nv p`` floats).
+
+    The estimate is that of the base regressor ``W`` and torques ``y`` of all samples stacked,
+    computed from their reduced statistics (the triangular factor of ``[W_j y_j]`` per joint,
+    :mod:`.reduced`); the condition number is ``sigma_1 / sigma_r`` of the singular values of
+    the stacked factor's ``r x r`` block, those of ``W``.
     """
     if method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     if base is None:
         base = base_parameters(model, damping=damping, coulomb=coulomb, armature=armature, offset=offset)
-    W, y = stack(model, base, log)
+    r = base.count
     with one_blas_thread():
-        s = np.linalg.svd(W, compute_uv=False)
+        stats = reduce_logs(model, base, log, preprocess=preprocess, client=client, block=block)
+        s = np.linalg.svd(stats.stacked()[:r, :r], compute_uv=False)
         cond = float(s[0] / s[-1]) if s[-1] > 0 else float("inf")
         if method == "ols":
-            est = ols(W, y, model.nv)
+            est = ols(stats)
         elif method == "wls":
-            est = wls(W, y, model.nv)
+            est = wls(stats)
         else:
-            est = physical(model, base, W, y, nominal_parameters(model, base), prior_weight=prior_weight)
-    return Identification(model, base, est, cond, base.project(nominal_parameters(model, base)), len(log))
+            est = physical(model, base, stats, nominal_parameters(model, base), prior_weight=prior_weight)
+    return Identification(model, base, est, cond, base.project(nominal_parameters(model, base)), stats.samples, s)

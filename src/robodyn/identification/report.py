@@ -7,8 +7,8 @@
   base parameters with their singular-value gap;
 * ``torques.png``: measured and predicted torque of every joint over time;
 * ``residuals.png``: measured minus predicted torque, and its histogram per joint;
-* ``singular_values.png``: singular values of the stacked base regressor (condition number
-  in the title).
+* ``singular_values.png``: singular values of the stacked base regressor of the samples
+  identified from (``Identification.singular_values``, all logs), condition number in the title.
 """
 
 from __future__ import annotations
@@ -86,8 +86,10 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     _save(fig, paths[-1])
     plt.close(fig)
 
-    W = result.base.regressor(model, log.q, log.v, log.a).reshape(-1, result.base.count)
-    s = np.linalg.svd(W, compute_uv=False)
+    s = result.singular_values
+    if s is None:  # an Identification made by hand: those of the log's regressor
+        s = np.linalg.svd(result.base.regressor(model, log.q, log.v, log.a).reshape(-1, result.base.count),
+                          compute_uv=False)
     fig, ax = plt.subplots(figsize=(7, 4))
     ax.semilogy(np.arange(1, s.size + 1), s, "o-")
     ax.set_xlabel("index")

@@ -20,6 +20,9 @@ Two encodings, chosen by the file's suffix: CSV (any suffix but ``.parquet``, fu
 precision) and Parquet (``.parquet``, one float64 column per name; needs ``pyarrow``,
 ``pip install "robodyn[parquet]"``), for large logs.
 
+A table already in memory with these columns (a pandas DataFrame, one partition of a Dask
+DataFrame) is read by :func:`read_frame`, with the same checks (:func:`table_log`).
+
 The older spelling of identification logs, ``time, q_<joint>, qd_<joint>, qdd_<joint>,
 tau_<joint>``, is still read, with a :class:`~robodyn.errors.RobodynDeprecationWarning`.
 """
@@ -123,21 +126,52 @@ def read_log(path, model, *, require_tau: bool = False) -> Log:
     """
     path = Path(path)
     header, data, lines, text = _read_table(path)
-    header = _new_spelling(header, model, path)
+    return table_log(header, data, model, source=path, lines=lines, text=text, require_tau=require_tau,
+                     stacklevel=3)
+
+
+def read_frame(frame, model, *, source="data frame", require_tau: bool = False) -> Log:
+    """A log of a table in memory with the columns of the format (a pandas DataFrame, one
+    partition of a Dask DataFrame): :func:`table_log` of its column names and values. A
+    column that does not convert to float counts as text (kept out, or an error when it is
+    one of the log's columns); rows are numbered as lines of the frame written as CSV (the
+    header on line 1). ``source`` names the frame in the messages."""
+    header = [str(name).strip() for name in frame.columns]
+    data, text = np.full((len(frame), len(header)), np.nan), {}
+    for c, name in enumerate(frame.columns):
+        try:
+            data[:, c] = np.asarray(frame[name].to_numpy(), dtype=float)
+        except (TypeError, ValueError):
+            text[c] = f"{source}: column {header[c]!r} is not numeric"
+    return table_log(header, data, model, source=source, lines=np.arange(len(frame)) + 2, text=text,
+                     require_tau=require_tau, stacklevel=3)
+
+
+def table_log(header, data, model, *, source, lines=None, text=None, require_tau: bool = False,
+              stacklevel: int = 2) -> Log:
+    """The log of a table read by :func:`read_log` or :func:`read_frame`: ``header`` (ncols)
+    column names, ``data`` (N, ncols) floats with NaN for empty fields, ``lines`` (N,) the
+    line of each row in messages (default 2, 3, ...), ``text`` ``{column: message}`` for the
+    columns holding text. Checks and errors as :func:`read_log`'s, naming ``source``;
+    ``stacklevel``: the frame the warnings point at (2: the caller of this function)."""
+    data = np.asarray(data, dtype=float)
+    lines = np.arange(data.shape[0]) + 2 if lines is None else np.asarray(lines)
+    text = {} if text is None else text
+    header = _new_spelling(header, model, source, stacklevel + 2)
     index = {name: k for k, name in enumerate(header)}
     if len(index) != len(header):
-        raise ValueError(f"{path}: repeated column names {sorted({h for h in header if header.count(h) > 1})}")
+        raise ValueError(f"{source}: repeated column names {sorted({h for h in header if header.count(h) > 1})}")
     need = ["t"] + columns(model, "q") + (columns(model, "tau") if require_tau else [])
     missing = [n for n in need if n not in index]
     if missing:
-        raise ValueError(f"{path}: missing columns {missing} for model {model.name!r}; expected t, q:<coordinate>"
+        raise ValueError(f"{source}: missing columns {missing} for model {model.name!r}; expected t, q:<coordinate>"
                          f"{', tau:<dof>' if require_tau else ''} with coordinates {model.q_names}")
     kinds = []
     for kind in KINDS:
         names = columns(model, kind)
         present = [n for n in names if n in index]
         if present and len(present) != len(names):
-            raise ValueError(f"{path}: {kind} given for some entries only; missing columns "
+            raise ValueError(f"{source}: {kind} given for some entries only; missing columns "
                              f"{[n for n in names if n not in index]}")
         if present:
             kinds.append(kind)
@@ -146,24 +180,24 @@ def read_log(path, model, *, require_tau: bool = False) -> Log:
         if header[c] in wanted:
             raise ValueError(text[c])
     if text:
-        warnings.warn(f"{path}: columns {[header[c] for c in sorted(text)]} hold text and are not read",
-                      RobodynWarning, stacklevel=2)
+        warnings.warn(f"{source}: columns {[header[c] for c in sorted(text)]} hold text and are not read",
+                      RobodynWarning, stacklevel=stacklevel)
         keep = [k for k in range(len(header)) if k not in text]
         header, data = [header[k] for k in keep], data[:, keep]
         index = {name: k for k, name in enumerate(header)}
     blocks = {kind: [index[n] for n in columns(model, kind)] for kind in kinds}
     if data.shape[0] < 2:
-        raise ValueError(f"{path}: {data.shape[0]} data rows, need at least 2")
+        raise ValueError(f"{source}: {data.shape[0]} data rows, need at least 2")
     bad = ~np.isfinite(data).all(axis=1)
     if bad.any():
         shown = lines[bad][:20].tolist()
-        raise ValueError(f"{path}: {int(bad.sum())} rows with missing or non-finite values at lines {shown}"
+        raise ValueError(f"{source}: {int(bad.sum())} rows with missing or non-finite values at lines {shown}"
                          f"{' ...' if bad.sum() > 20 else ''}; remove or repair them")
     t = data[:, index["t"]].copy()
     step = np.diff(t)
     if np.any(step <= 0):
         k = int(np.flatnonzero(step <= 0)[0])
-        raise ValueError(f"{path}: time not strictly increasing at line {lines[k + 1]} "
+        raise ValueError(f"{source}: time not strictly increasing at line {lines[k + 1]} "
                          f"(t = {float(t[k + 1])!r} after {float(t[k])!r} on line {lines[k]})")
     extra = {h: data[:, k].copy() for h, k in index.items() if h not in wanted}
     return Log(t=t, **{kind: data[:, cols].copy() for kind, cols in blocks.items()}, extra=extra)
@@ -251,9 +285,10 @@ def _read_table(path: Path) -> tuple[list[str], np.ndarray, np.ndarray, dict]:
     return header, data, np.array([ln for ln, _ in rows], dtype=np.int64), text
 
 
-def _new_spelling(header: list[str], model, path) -> list[str]:
+def _new_spelling(header: list[str], model, path, stacklevel: int) -> list[str]:
     """The header with the old identification spelling (``time``, ``q_<joint>``,
-    ``qd_<joint>``, ``qdd_<joint>``, ``tau_<joint>``) renamed, with one warning."""
+    ``qd_<joint>``, ``qdd_<joint>``, ``tau_<joint>``) renamed, with one warning (at
+    ``stacklevel``, as for ``warnings.warn`` called here)."""
     one_dof = set(model.body_joint_names) & set(model.dof_names)  # the only joints the old spelling had
     old = {"time": "t"}
     for prefix, kind in OLD_KINDS.items():
@@ -261,5 +296,5 @@ def _new_spelling(header: list[str], model, path) -> list[str]:
     if "t" in header or not any(h in old for h in header):
         return header
     warn_renamed(f"{path}: columns time, q_<joint>, qd_<joint>, qdd_<joint>, tau_<joint>",
-                 "t, q:<joint>, v:<joint>, a:<joint>, tau:<joint>", "log file", stacklevel=4)
+                 "t, q:<joint>, v:<joint>, a:<joint>, tau:<joint>", "log file", stacklevel=stacklevel)
     return [old.get(h, h) for h in header]
