@@ -11,7 +11,7 @@ inertia and friction, reflected through the gear: ``N^2 J_m`` on the joint's arm
 ``simulate`` and identification (armature and friction columns) all see the motors, the
 reflected terms go into the model: :meth:`DCMotor.plant` returns it; the electrical part is a
 controller with an internal state (the currents), :class:`VoltageDrive`, that
-:func:`robodyn.simulate` integrates with the robot:
+:func:`robodyn.simulate` integrates with the robot::
 
     motor = actuators.DCMotor(torque_constant=0.05, back_emf=0.05, resistance=1.0,
                               inductance=1e-3, gear_ratio=50.0, rotor_inertia=1e-5)

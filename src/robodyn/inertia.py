@@ -1,4 +1,4 @@
-"""Rotational inertias (3 x 3) of uniform bodies, the parallel-axis shift and rotation.
+"""Rotational inertias (3 x 3) of uniform bodies, the parallel-axis shift and rotation::
 
     import robodyn as rd
     I = rd.inertia.rod(10.0, 1.0, "x")                       # m L^2 / 12 about its centre
@@ -6,7 +6,7 @@
     b.add_link("link1", mass=10.0, com=(0.5, 0, 0), inertia=I)  # ModelBuilder takes I about the CoM
 
 Every shape's inertia is about its centre of mass, in a frame whose axes are the shape's:
-``axis`` is ``"x"``, ``"y"``, ``"z"`` or a unit vector. Formulas (uniform density, mass ``m``):
+``axis`` is ``"x"``, ``"y"``, ``"z"`` or a unit vector. Formulas (uniform density, mass ``m``)::
 
     rod(m, L, axis)               m L^2 / 12 about the axes across it, 0 along it
     cylinder(m, r, L, axis)       m r^2 / 2 about its axis, m (3 r^2 + L^2) / 12 across it

@@ -87,7 +87,7 @@ def kinetic_energy(model, q, v, *, check_finite: bool = True):
 
 
 def potential_energy(model, q, *, check_finite: bool = True):
-    """Gravitational potential energy ``-sum_i m_i g . c_i``: (...,) for q (..., nq)."""
+    """Gravitational potential energy ``-sum_i m_i g^T c_i``: (...,) for q (..., nq)."""
     if any_lazy(q):
         return deferred(potential_energy, locals())
     batch, OUT = _run(model, check_finite, "potential_energy", q=q)

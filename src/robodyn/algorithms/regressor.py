@@ -255,7 +255,7 @@ def _slotine_li_single(ints, body, dofs, params, q, v, v_r, a_r, check, Y):
 def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic-energy regressor (when ``v`` has entries), ``out[1]`` potential.
 
-    ``T = sum_i 1/2 V_i . I(theta_i) V_i``; ``U = -g . sum_i (m_i p_i + R_i h_i)``.
+    ``T = sum_i 1/2 V_i^T I(theta_i) V_i``; ``U = -g^T sum_i (m_i p_i + R_i h_i)``.
     """
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = ws
     status = poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op)
@@ -438,7 +438,7 @@ def _energy(model, check_finite, what, **arrays):
 
 def kinetic_energy_regressor(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """``Y_T`` (..., 10 nbodies) with ``Y_T @ model.inertial_parameters() ==
-    kinetic_energy(model, q, v)``: ``T = sum_i 1/2 V_i . I(theta_i) V_i`` (body twists
+    kinetic_energy(model, q, v)``: ``T = sum_i 1/2 V_i^T I(theta_i) V_i`` (body twists
     ``V_i`` in body frames; armature not included, as in ``kinetic_energy``)."""
     if any_lazy(q, v):
         return deferred(kinetic_energy_regressor, locals())
@@ -447,7 +447,7 @@ def kinetic_energy_regressor(model, q, v, *, check_finite: bool = True) -> np.nd
 
 def potential_energy_regressor(model, q, *, check_finite: bool = True) -> np.ndarray:
     """``Y_U`` (..., 10 nbodies) with ``Y_U @ model.inertial_parameters() ==
-    potential_energy(model, q)``: ``U = -g . sum_i (m_i p_i + R_i h_i)`` (world pose
+    potential_energy(model, q)``: ``U = -g^T sum_i (m_i p_i + R_i h_i)`` (world pose
     ``(R_i, p_i)`` of body ``i``), so only the mass and first-moment columns are non-zero."""
     if any_lazy(q):
         return deferred(potential_energy_regressor, locals())

@@ -168,7 +168,7 @@ class Capsule:
 
 @dataclass(frozen=True, eq=False)
 class Plane:
-    """The static half-space ``normal . x <= height`` (world coordinates), its surface a
+    """The static half-space ``normal^T x <= height`` (world coordinates), its surface a
     plane: the ground by default. ``friction``: Coulomb's ``mu >= 0``; ``restitution``:
     Newton's ``0 <= e <= 1`` (0: impacts are inelastic)."""
 
@@ -356,8 +356,10 @@ class Contacts:
 
 
 def shapes_from_urdf(source, links=None, *, cylinders: str = "capsule", meshes: str = "skip") -> list:
-    """The contact shapes of a URDF's ``<collision>`` elements (file path or XML string), on
-    the links (or the frames that fixed joints merge them into) that carry them: spheres,
+    """The contact shapes of the ``<collision>`` elements of a URDF.
+
+    ``source`` is a file path or an XML string. The shapes sit on the links (or the frames
+    that fixed joints merge them into) that carry them: spheres,
     boxes, and cylinders as capsules of the same radius and overall length (``cylinders=
     "capsule"``, rounded ends; ``"error"`` refuses them). Meshes are not read: ``meshes="skip"``
     leaves them out with one warning naming their links, ``"error"`` refuses them. ``links``:
