@@ -144,3 +144,38 @@ def test_position_servo():
     held = MOTOR["torque_constant"] * MOTOR["gear_ratio"] * kp * (0.5 - q) / MOTOR["resistance"]
     assert held == pytest.approx(rd.gravity(pendulum, run.q[-1])[0], rel=1e-6)
     assert 0.01 < q - 0.5 < 0.1  # the offset a proportional servo leaves under load
+
+
+def test_composite_tracking_of_elastic_joints():
+    """Spong's composite control: the links track a quintic motion like the rigid robot under
+    computed torque (the error shrinking as K grows), and the fast damping Kv (v - theta')
+    is what keeps the elastic mode down: the rigid law alone lets it grow."""
+    model = rd.models.load("double_pendulum")
+    q0, q1, B = np.array([0.4, -0.3]), np.array([-0.2, 0.5]), np.array([0.05, 0.05])
+    ref = rd.control.quintic(q0, q1, 1.0)
+    kp, kd = 100.0, 20.0
+    errors = []
+    for K in (2e3, 2e4):
+        law = actuators.composite_tracking(model, ref, B, kp, kd, kv=2.0)
+        theta0 = q0 + rd.gravity(model, q0) / K  # the springs hold the links still at the start
+        flexible = actuators.FlexibleJoints(model, K, B, law, theta0=theta0)
+        run = rd.simulate(model, q0, np.zeros(2), 1.5, 2e-4, controller=flexible, integrator="rk4")
+        errors.append(np.abs(run.q - np.array([ref(t)[0] for t in run.t])).max())
+    assert errors[1] < 3e-3 and errors[0] / errors[1] > 4, errors  # ten times stiffer: much closer
+    # the elastic mode: the rigid law alone lets it grow (the closed loop is unstable); with
+    # the fast damping it stays small
+    K = 2e3
+    theta0 = q0 + rd.gravity(model, q0) / K
+    rigid_law = rd.control.ComputedTorque(model.replace(armature=B), ref, kp, kd)
+    undamped = actuators.FlexibleJoints(model, K, B, lambda t, q, v, th, thd: rigid_law(t, q, v), theta0=theta0)
+    damped = actuators.FlexibleJoints(model, K, B, actuators.composite_tracking(model, ref, B, kp, kd, 2.0),
+                                      theta0=theta0)
+    stretch = {}
+    for name, plant_law in (("undamped", undamped), ("damped", damped)):
+        run = rd.simulate(model, q0, np.zeros(2), 0.6, 2e-4, controller=plant_law, integrator="rk4")
+        s = np.abs(run.controller_state[:, :2] - run.q).max(axis=1)
+        stretch[name] = (s[run.t <= 0.1].max(), s[run.t > 0.5].max())
+    assert stretch["undamped"][1] > 4 * stretch["undamped"][0], stretch  # growing
+    assert stretch["damped"][1] < 0.2 * stretch["undamped"][1], stretch
+    with pytest.raises(ValueError, match="kv"):
+        actuators.composite_tracking(model, ref, B, kp, kd, kv=-1.0)

@@ -179,6 +179,28 @@ def motor_pd_gravity(model, q_desired, stiffness, kp, kd):
     return lambda t, q, v, theta, theta_dot: kp * (theta_d - theta) - kd * theta_dot + g_d
 
 
+def composite_tracking(model, reference, motor_inertia, kp, kd, kv):
+    """Singular-perturbation (composite) tracking for elastic joints: ``u = u_s + u_f``.
+
+    The slow law ``u_s`` is computed torque for the rigid robot the elastic one approaches
+    as ``K`` grows, the motors' inertia ``B`` on its joints: ``(M(q) + B) q'' + C v + g = u_s``,
+    ``u_s = rnea_B(q, v, q_d'' + Kd e' + Kp e)``. The fast law ``u_f = Kv (v - theta')``
+    damps the elastic mode, whose variable ``z = K (theta - q)`` otherwise oscillates at
+    ``sqrt(K (B^-1 + M^-1))`` without decaying. With ``Kv > 0`` the link error follows the
+    rigid error dynamics ``e'' + Kd e' + Kp e = 0`` up to ``O(1 / K)``. A motor law for
+    :class:`FlexibleJoints`; ``reference`` as in :class:`robodyn.control.ComputedTorque`.
+    Reference: M. W. Spong, K. Khorasani and P. V. Kokotovic, "An integral manifold approach
+    to the feedback control of flexible joint robots", IEEE J. Robot. Autom. 3(4), 1987;
+    Spong, Hutchinson & Vidyasagar (2006), section 9.4.
+    """
+    from .control.controllers import ComputedTorque, gain
+
+    B = gain("motor_inertia", motor_inertia, model.nv)
+    kv = gain("kv", kv, model.nv)
+    slow = ComputedTorque(model.replace(armature=model.armature + B), reference, kp, kd)
+    return lambda t, q, v, theta, theta_dot: slow(t, q, v) + kv * (v - theta_dot)
+
+
 def position_servo(q_desired, kp, kd):
     """A voltage law for :class:`VoltageDrive`: a PD on the motor side, ``V = kp (q_d - q) -
     kd v`` (V/rad, V s/rad), the hobby servo's loop. With gravity the joint settles where the
