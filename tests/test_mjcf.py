@@ -118,10 +118,23 @@ def compare_with_mujoco(model: rd.Model, mm, states: int = 3, seed: int = 0, lab
         np.testing.assert_allclose(model.armature, mm.dof_armature, rtol=0, atol=0)
         np.testing.assert_allclose(model.damping, mm.dof_damping, rtol=0, atol=0)
         np.testing.assert_allclose(model.coulomb, mm.dof_frictionloss, rtol=0, atol=0)
-    # not rigid-body dynamics: constraints, springs, fluid forces, and the Euler integrator's
-    # implicit damping (which mj_inverse adds as h D qacc)
-    mm.opt.disableflags |= (mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_SPRING
-                            | mujoco.mjtDisableBit.mjDSBL_EULERDAMP)
+    # not rigid-body dynamics: constraints, fluid forces, and the Euler integrator's implicit
+    # damping (which mj_inverse adds as h D qacc); springs of hinges and slides are the
+    # model's, those of ball and free joints and of tendons are not modelled (then MuJoCo
+    # runs without any)
+    mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONSTRAINT | mujoco.mjtDisableBit.mjDSBL_EULERDAMP
+    ball_free = [j for j in range(mm.njnt)
+                 if int(mm.jnt_type[j]) in (int(mujoco.mjtJoint.mjJNT_FREE), int(mujoco.mjtJoint.mjJNT_BALL))]
+    if any(mm.jnt_stiffness[j] != 0 for j in ball_free) or np.any(mm.tendon_stiffness != 0):  # tendons: not modelled
+        mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_SPRING
+        model = model.replace(stiffness=np.zeros(model.nv), spring_reference=np.zeros(model.nv))
+    elif model.nv:
+        one = [j for j in range(mm.njnt) if j not in ball_free]
+        stiffness, reference = np.zeros(mm.nv), np.zeros(mm.nv)
+        stiffness[mm.jnt_dofadr[one]] = mm.jnt_stiffness[one]
+        reference[mm.jnt_dofadr[one]] = mm.qpos_spring[mm.jnt_qposadr[one]]
+        np.testing.assert_allclose(model.stiffness, stiffness, rtol=0, atol=0)
+        np.testing.assert_allclose(model.spring_reference, reference, rtol=1e-15, atol=1e-15)
     mm.opt.density = mm.opt.viscosity = 0.0
     # MuJoCo's frictionloss is a constraint. Armature on a free joint multiplies qacc in
     # MuJoCo, d/dt v (body frame) in robodyn: the same mass matrix, but biases apart by
@@ -237,7 +250,9 @@ def test_radians():
 
 
 @pytest.mark.parametrize("joint", ['type="slide" axis="0 1 1" ref="0.2"', 'ref="30" pos="0.1 0 0.2" axis="1 1 1"',
-                                   'range="-30 60"', 'range="-30 60" limited="false"', 'armature="0.3" damping="2"'])
+                                   'range="-30 60"', 'range="-30 60" limited="false"', 'armature="0.3" damping="2"',
+                                   'stiffness="40" springref="25" ref="10"',
+                                   'type="slide" axis="0 0 1" stiffness="300" springref="-0.05" damping="1"'])
 def test_joint_attributes(joint):
     model = check(_mjcf(_ARM.format(orient="", joint=joint)))
     if joint == 'range="-30 60"':
@@ -377,7 +392,7 @@ def test_sites_are_frames_and_name_clashes_are_prefixed():
 
 
 def test_ignored_elements_are_listed_in_one_warning():
-    xml = _mjcf('<body name="b"><joint name="j" stiffness="3"/><geom size="0.1"/><camera name="c"/></body>',
+    xml = _mjcf('<body name="b"><joint name="j" type="ball" stiffness="3"/><geom size="0.1"/><camera name="c"/></body>',
                 top='<actuator><motor joint="j"/></actuator><tendon/><equality/><sensor/><asset/><visual/>')
     with pytest.warns(rd.RobodynWarning) as rec:
         rd.load_mjcf(xml)
@@ -385,7 +400,7 @@ def test_ignored_elements_are_listed_in_one_warning():
     msg = str(rec[0].message)
     for tag in ("actuator", "tendon", "equality", "sensor"):
         assert f"1 <{tag}>" in msg
-    assert "joint springs (stiffness) not modelled: ['j']" in msg
+    assert "springs of ball and free joints (stiffness) not modelled: ['j']" in msg
     assert "asset" not in msg and "visual" not in msg and "camera" not in msg
 
 

@@ -35,7 +35,7 @@ def round_trip(model) -> rd.Model:
     # 1e-11: a point mass comes back with principal inertias of 1e-12 of the largest (see write_mjcf)
     assert_rel(rd.rnea(back, q, v, a), rd.rnea(model, q, v, a), 1e-11)
     assert_rel(rd.crba(back, q), rd.crba(model, q), 1e-11)
-    for key in ("lower", "upper", "damping", "coulomb", "armature"):
+    for key in ("lower", "upper", "damping", "coulomb", "armature", "stiffness", "spring_reference"):
         np.testing.assert_array_equal(getattr(back, key), getattr(model, key), err_msg=key)
     return back
 
@@ -61,7 +61,7 @@ def test_random_trees_of_every_joint_type(seed, floating_base):
     lower = np.where(one & (rng.random(model.nv) < 0.5), -rng.uniform(0.5, 2, model.nv), -np.inf)
     free = np.concatenate([np.full(J.NV[t], t == J.FREE) for t in model.joint_type])
     model = model.replace(damping=per_joint * ~free, armature=0.1 * per_joint * ~free, coulomb=0.5 * per_joint * ~free,
-                          lower=lower, upper=-lower)
+                          lower=lower, upper=-lower, stiffness=20 * per_joint * one, spring_reference=0.3 * one)
     round_trip(model)
 
 

@@ -156,7 +156,8 @@ class ModelBuilder:
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
                   upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
-                  armature=0.0, pitch: float = 0.0, axis2=None, where: str | None = None) -> None:
+                  armature=0.0, stiffness=0.0, spring_reference=0.0, pitch: float = 0.0, axis2=None,
+                  where: str | None = None) -> None:
         """A joint from ``parent`` to ``child``; its frame is at ``xyz``/``rpy`` (or ``rotation``)
         in the parent link frame and the child frame coincides with it at ``q = 0``.
 
@@ -171,13 +172,17 @@ class ModelBuilder:
         ``universal`` (a Cardan joint): a rotation ``q1`` about ``axis``, then ``q2`` about
         ``axis2`` in the turned frame, ``R = Rot(axis, q1) Rot(axis2, q2)`` as Pinocchio's
         ``JointModelUniversal``. It is built exactly as two revolute joints ``name[1]`` and
-        ``name[2]`` on a massless cross link ``child:name``; the limits, damping, friction and
-        armature may be scalars or pairs."""
+        ``name[2]`` on a massless cross link ``child:name``; the limits, damping, friction,
+        armature and springs may be scalars or pairs.
+
+        ``stiffness`` and ``spring_reference``: a joint spring ``tau = stiffness (q -
+        spring_reference)`` that the actuator works against (joints of one dof)."""
         where = where or f"{self.source}: joint {name!r}"
         if type == "universal":
             return self._add_universal(name, parent, child, xyz, rpy, axis, axis2, rotation, where,
                                        dict(lower=lower, upper=upper, velocity=velocity, effort=effort,
-                                            damping=damping, friction=friction, armature=armature))
+                                            damping=damping, friction=friction, armature=armature,
+                                            stiffness=stiffness, spring_reference=spring_reference))
         if type not in JOINT_TYPES:
             raise ModelError(f"{where}: unknown joint type {type!r}; supported: {sorted([*JOINT_TYPES, 'universal'])}")
         rot = np.asarray(rpy if rotation is None else rotation, dtype=float)
@@ -198,12 +203,17 @@ class ModelBuilder:
             lower, upper = -np.inf, np.inf
         limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
                       effort=float(effort), damping=float(damping), friction=float(friction),
-                      armature=float(armature))
+                      armature=float(armature), stiffness=float(stiffness), spring_reference=float(spring_reference))
+        finite = ("damping", "friction", "armature", "stiffness")
         for k, val in limits.items():
             if np.isnan(val):
                 raise ModelError(f"{where}: {k} is NaN")
-            if k not in ("lower", "upper") and (val < 0 or (k in ("damping", "friction", "armature") and not np.isfinite(val))):
+            if k == "spring_reference" and not np.isfinite(val):
+                raise ModelError(f"{where}: spring_reference must be finite, got {val}")
+            if k not in ("lower", "upper", "spring_reference") and (val < 0 or (k in finite and not np.isfinite(val))):
                 raise ModelError(f"{where}: {k} must be finite and >= 0, got {val}")
+        if (stiffness or spring_reference) and type in ("free", "spherical", "planar", "fixed"):
+            raise ModelError(f"{where}: joint springs on a {type} joint; only joints of one dof have them")
         if limits["lower"] > limits["upper"]:
             raise ModelError(f"{where}: lower limit {lower} exceeds upper limit {upper}")
         if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
@@ -303,7 +313,8 @@ class ModelBuilder:
             dofs.extend([lim] * int(J.NV[code]))
             return len(parent) - 1
 
-        free = dict(lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0, armature=0.0)
+        free = dict(lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0, armature=0.0,
+                    stiffness=0.0, spring_reference=0.0)
         if floating_base:
             b = new_body(-1, J.FREE, np.zeros(3), np.eye(3), np.zeros(3), root, "root_joint", free)
             place = {root: (b, np.eye(3), np.zeros(3))}
@@ -350,8 +361,8 @@ class ModelBuilder:
             theta=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
             gravity=self.gravity, lower=col("lower"), upper=col("upper"),
             velocity_limit=col("velocity"), effort_limit=col("effort"), damping=col("damping"),
-            coulomb=col("friction"), armature=col("armature"),
-            frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
+            coulomb=col("friction"), armature=col("armature"), stiffness=col("stiffness"),
+            spring_reference=col("spring_reference"), frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
             frame_R=np.reshape([f[2] for f in frames], (len(frames), 3, 3)),
             frame_p=np.reshape([f[3] for f in frames], (len(frames), 3)), name=self.name,
         )

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import inline
-from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, XTREE_P, XTREE_R
+from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, SPRING_REF, STIFFNESS, XTREE_P, XTREE_R
 from .joints import HELICAL, PLANAR, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
@@ -108,12 +108,16 @@ def body_placement(jtype, row, q, iq, R, p, Rj):
 
 
 @inline
-def friction_torque(dofs, eps, v, k):
-    """Joint friction torque opposed by the actuator at dof ``k``: ``b v + Fc sgn(v)``.
+def friction_torque(dofs, eps, q, iq, v, k):
+    """Passive joint torque opposed by the actuator at dof ``k``: friction and the joint
+    spring, ``b v + Fc sgn(v) + K (q - q_ref)``.
 
     ``dofs[k, DAMPING] = b`` (viscous), ``dofs[k, COULOMB] = Fc``; ``sgn`` is ``sign`` when
-    ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``).
+    ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``);
+    ``dofs[k, STIFFNESS] = K``, ``dofs[k, SPRING_REF] = q_ref`` and ``q[iq]`` the joint's
+    coordinate (springs sit on joints of one dof only; ``K`` is 0 on the others, whatever
+    ``q[iq]`` then holds).
     """
     vk = v[k]
     s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
-    return dofs[k, DAMPING] * vk + dofs[k, COULOMB] * s
+    return dofs[k, DAMPING] * vk + dofs[k, COULOMB] * s + dofs[k, STIFFNESS] * (q[iq] - dofs[k, SPRING_REF])

@@ -22,7 +22,8 @@ The tables (built once per model by :func:`pack`, reached as ``model.kernel``):
     and the joint constants (``JOINT_CONSTANTS``, 27, ``joints.joint_constants``).
 ``dofs[(friction, armature)]`` (nv, DOF_COLUMNS) float, one row per dof: the motion
     subspace column in the child frame (``MOTION``, 6), then ``ARMATURE``, ``DAMPING``
-    (viscous) and ``COULOMB``, zeroed when switched off.
+    (viscous), ``COULOMB``, the joint spring's ``STIFFNESS`` (zeroed when switched off, with
+    friction) and its rest position ``SPRING_REF``.
 ``params[with_gravity]`` (PARAMS_SIZE,): gravity (``GRAVITY``, 3, or zeros) and the Coulomb
     smoothing velocity (``SMOOTHING``).
 ``zero_wrench`` (nb, 6): no external wrench. ``multi_dof_bodies``: the bodies whose joint has several dofs (free, spherical).
@@ -53,8 +54,8 @@ INERTIA_END = INERTIA + 10
 BODY_COLUMNS = JOINT_CONSTANTS + J.JOINT_CONSTANTS_SIZE
 
 # ``dofs`` columns
-MOTION, ARMATURE, DAMPING, COULOMB = 0, 6, 7, 8
-DOF_COLUMNS = 9
+MOTION, ARMATURE, DAMPING, COULOMB, STIFFNESS, SPRING_REF = 0, 6, 7, 8, 9, 10
+DOF_COLUMNS = 11
 
 # ``params`` entries
 GRAVITY, SMOOTHING = 0, 3
@@ -101,6 +102,7 @@ def pack(model) -> KernelTables:
         Si = J.motion_subspace(int(model.joint_type[i]), model.joint_axis[i], model.joint_pitch[i])
         full[k:k + Si.shape[0], MOTION:MOTION + 6] = Si
     full[:, ARMATURE], full[:, DAMPING], full[:, COULOMB] = model.armature, model.damping, model.coulomb
+    full[:, STIFFNESS], full[:, SPRING_REF] = model.stiffness, model.spring_reference
     for i in range(nb):
         S = full[model.idx_v[i], MOTION:MOTION + 6]
         unit = ints[i, NDOF] == 1 and np.count_nonzero(S) == 1 and S.max() == 1.0
@@ -112,6 +114,7 @@ def pack(model) -> KernelTables:
             d[:, ARMATURE] *= armature
             d[:, DAMPING] *= friction
             d[:, COULOMB] *= friction
+            d[:, STIFFNESS] *= friction
             dofs[(friction, armature)] = d
     params = {}
     for with_gravity in (True, False):

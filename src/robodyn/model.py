@@ -149,7 +149,9 @@ class Model:
     order), ``idx_q`` (nb,), ``idx_v`` (nb,).
     Per-dof arrays (nv,): ``lower``, ``upper`` (position limits of 1-dof joints, +-inf for free
     joints), ``velocity_limit``, ``effort_limit``, ``damping`` (viscous, N m s/rad), ``coulomb``
-    (N m), ``armature`` (reflected rotor inertia, kg m^2). Frames (nf): ``frame_names``,
+    (N m), ``armature`` (reflected rotor inertia, kg m^2), ``stiffness`` and ``spring_reference``
+    (joint springs ``tau = stiffness (q - spring_reference)`` opposed by the actuator, N m/rad
+    or N/m; joints of one dof only). Frames (nf): ``frame_names``,
     ``frame_body`` (-1 for the world), ``frame_R`` (nf, 3, 3), ``frame_p`` (nf, 3).
     ``gravity`` (3,) in the world frame.
     """
@@ -158,7 +160,7 @@ class Model:
         "name", "parent", "joint_type", "joint_axis", "joint_pitch", "X_tree_R", "X_tree_p", "theta",
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
-        "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
+        "stiffness", "spring_reference", "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
         "physical", "kernel", "_frame_index",
     )
 
@@ -181,6 +183,8 @@ class Model:
         damping=None,
         coulomb=None,
         armature=None,
+        stiffness=None,
+        spring_reference=None,
         coulomb_smoothing: float = 0.0,
         frame_names: Sequence[str] = (),
         frame_body=(),
@@ -281,6 +285,18 @@ class Model:
             if key in ("damping", "coulomb", "armature") and not np.all(np.isfinite(a)):
                 raise ModelError(f"{key} must be finite, got {a.tolist()}")
             dofs[key] = a
+        stiff = arr(stiffness, (nv,), "stiffness")
+        if not np.all(np.isfinite(stiff)) or np.any(stiff < 0):
+            raise ModelError(f"stiffness must be finite and non-negative, got {stiff.tolist()}")
+        ref = arr(spring_reference, (nv,), "spring_reference")
+        if not np.all(np.isfinite(ref)):
+            raise ModelError(f"spring_reference must be finite, got {ref.tolist()}")
+        for i in np.flatnonzero(nv_i > 1) if nb else ():
+            k = slice(idx_v[i], idx_v[i] + nv_i[i])
+            if np.any(stiff[k] != 0) or np.any(ref[k] != 0):
+                raise ModelError(f"body {i}: joint springs (stiffness, spring_reference) on a {J.NAMES[jt[i]]} joint; "
+                                 f"only joints of one dof (revolute, prismatic, helical) have them")
+        dofs["stiffness"], dofs["spring_reference"] = stiff, ref
         if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo > hi):
             raise ModelError("joint position limits must satisfy lower <= upper")
         if not (np.isfinite(coulomb_smoothing) and coulomb_smoothing >= 0):
@@ -401,11 +417,12 @@ class Model:
     inertia = renamed_attribute("inertia", "theta")  # ``inertia`` names 3 x 3 matrices in robodyn
 
     def rigid(self) -> "Model":
-        """The model without joint friction and armature (``damping``, ``coulomb`` and
-        ``armature`` zero): its ``rnea`` is the textbook ``M(q) a + C(q, v) v + g(q)`` of the
-        rigid bodies alone, as ``rnea(..., friction=False, armature=False)`` of this model."""
+        """The model without joint friction, springs and armature (``damping``, ``coulomb``,
+        ``stiffness`` and ``armature`` zero): its ``rnea`` is the textbook ``M(q) a + C(q, v) v +
+        g(q)`` of the rigid bodies alone, as ``rnea(..., friction=False, armature=False)`` of
+        this model."""
         zero = np.zeros(self.nv)
-        return self.replace(damping=zero, coulomb=zero, armature=zero)
+        return self.replace(damping=zero, coulomb=zero, armature=zero, stiffness=zero, spring_reference=zero)
 
     def replace(self, **changes) -> "Model":
         """A new model with some constructor arguments changed (validated again)."""
@@ -415,7 +432,7 @@ class Model:
         kw = {k: getattr(self, k) for k in (
             "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta", "link_names",
             "body_joint_names", "gravity", "lower", "upper", "velocity_limit", "effort_limit",
-            "damping", "coulomb", "armature", "coulomb_smoothing", "frame_names", "frame_body",
+            "damping", "coulomb", "armature", "stiffness", "spring_reference", "coulomb_smoothing", "frame_names", "frame_body",
             "frame_R", "frame_p", "name", "physical", "joint_pitch")}
         unknown = set(changes) - set(kw)
         if unknown:

@@ -407,7 +407,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if n == 1 and not known[iv]:
-            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, v, iv), ints[i, UNIT_AXIS]
+            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, q, ints[i, IQ], v, iv), ints[i, UNIT_AXIS]
             if axis >= 3:
                 ok = articulate_single_dof(IA[i], S[iv], dofs[iv, ARMATURE], c[i], pA[i], tau_f, iv, U[iv], Dinv, u,
                                            t1, t2, 3, 6)
@@ -436,7 +436,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                     s = 0.0
                     for r in range(6):
                         s += S[k, r] * pA[i, r]
-                    u[k] = tau_known[k] - s - friction_torque(dofs, eps, v, k)
+                    u[k] = tau_known[k] - s - friction_torque(dofs, eps, q, ints[i, IQ], v, k)
                 if free_root(ints, dofs, i):
                     continue  # solved in pass 3
                 if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
@@ -475,7 +475,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 s = 0.0
                 for r in range(6):
                     s += S[k, r] * t1[r]
-                tau[k] = s + dofs[k, ARMATURE] * qdd_known[k] + friction_torque(dofs, eps, v, k)
+                tau[k] = s + dofs[k, ARMATURE] * qdd_known[k] + friction_torque(dofs, eps, q, ints[i, IQ], v, k)
             continue
         if n == 1:
             s = 0.0
@@ -557,7 +557,7 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
         f_ext_frame=None) -> np.ndarray:
     """Forward dynamics: the acceleration produced by joint forces ``tau`` at ``(q, v)``.
 
-    ``a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) + sum_i J_i^T f_ext_i)``
+    ``a = (M(q) + armature)^-1 (tau - C(q, v) v - g(q) - friction(v) - spring(q) + sum_i J_i^T f_ext_i)``
 
     Args:
         q: (..., nq). v, tau: (..., nv). f_ext, frame, friction, armature,

@@ -160,7 +160,7 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
                 s = 0.0
                 for r in range(6):
                     s += dofs[k, MOTION + r] * f[i, r]
-            tau[k] = s + dofs[k, ARMATURE] * a[k] + friction_torque(dofs, eps, v, k)
+            tau[k] = s + dofs[k, ARMATURE] * a[k] + friction_torque(dofs, eps, q, ints[i, IQ], v, k)
         if par >= 0:
             force_act(liR[i], lip[i], f[i], t1)
             for r in range(6):
@@ -238,7 +238,7 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
          f_ext_frame=None) -> np.ndarray:
     """Inverse dynamics: the joint forces that produce acceleration ``a`` at state ``(q, v)``.
 
-    ``tau = M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i + armature * a + friction(v)``
+    ``tau = M(q) a + C(q, v) v + g(q) - sum_i J_i^T f_ext_i + armature * a + friction(v) + spring(q)``
 
     Args:
         q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
@@ -246,7 +246,8 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
             body, expressed in ``frame``: ``"local"`` (body frame, torque about the body
             origin), ``"world"`` (world axes, torque about the world origin) or
             ``"local_world_aligned"`` (world axes, torque about the body origin).
-        friction: add the model's joint friction ``damping v + coulomb sgn(v)``.
+        friction: add the model's passive joint torques, friction and springs: ``damping v +
+            coulomb sgn(v) + stiffness (q - spring_reference)``.
         armature: add the model's reflected rotor inertia ``armature * a``.
         check_finite: reject NaN/Inf inputs (turn off only in hot loops with trusted input).
         out: optional (..., nv) C-contiguous float64 array to write the result into (and

@@ -55,7 +55,7 @@ from numba import boolean
 
 from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
-from ..layout import ARMATURE, COULOMB, DAMPING, IV, NDOF, PARENT, SMOOTHING, SUBTREE_END
+from ..layout import ARMATURE, COULOMB, DAMPING, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
                        motion_cross, wrench_to_local)
 from ._lazy import any_lazy, deferred
@@ -317,6 +317,7 @@ def derivatives_state(ints, body, dofs, params, q, v, a, fext, fcode, check, dq,
             th = np.tanh(v[k] / eps)
             ds = (1.0 - th * th) / eps
         dv[k, k] += dofs[k, DAMPING] + dofs[k, COULOMB] * ds
+        dq[k, k] += dofs[k, STIFFNESS]  # the joint spring (joints of one dof: q's tangent is q)
         if mass:
             M[k, k] += dofs[k, ARMATURE]
     return result_status(check, finite2(dq) and finite2(dv))

@@ -176,6 +176,10 @@ def to_pinocchio(model: Model):
             setattr(pm, "lower" + suffix, -bound)
     pm.damping = np.asarray(model.damping, dtype=float).copy()
     pm.armature = np.asarray(model.armature, dtype=float).copy()
+    if np.any(model.stiffness != 0):
+        sprung = [model.dof_names[k] for k in np.flatnonzero(model.stiffness)]
+        warnings.warn(f"to_pinocchio: joint springs of {sprung} not converted (a pinocchio.Model has none)",
+                      RobodynWarning, stacklevel=2)
     return pm
 
 

@@ -32,8 +32,9 @@ SDF geoms (give the body an ``<inertial>``), shell inertia, elements that genera
 (``<composite>``, ``<flexcomp>``, ``<replicate>``, ``<attach>``), global coordinates, a free
 joint below a moving body. Ignored with one :class:`~robodyn.errors.RobodynWarning` listing
 them: elements that are not the rigid-body dynamics of the tree (actuators, tendons,
-equality constraints, sensors, contact pairs, ...), joint springs (``stiffness``) and
-gravity compensation (``gravcomp``). Visual elements (assets, cameras, lights) are skipped
+equality constraints, sensors, contact pairs, ...), springs of ball and free joints and
+gravity compensation (``gravcomp``). Springs of hinge and slide joints (``stiffness``,
+``springref``) are the model's ``stiffness`` and ``spring_reference``. Visual elements (assets, cameras, lights) are skipped
 silently. Contacts are not part of the model.
 
 The XML is read as the URDF loader reads it: DTDs, entities and external references
@@ -318,7 +319,7 @@ class _Bodies:
         self.links: list[_Link] = [_Link("world", where=f"{doc.name}: <worldbody>")]
         self.joints: list[tuple] = []  # (name, type, parent, child, xyz, R, axis, limits, where)
         self.sites: list[tuple] = []
-        self.unmodelled = {"joint springs (stiffness)": [], "gravity compensation (gravcomp)": []}
+        self.unmodelled = {"springs of ball and free joints (stiffness)": [], "gravity compensation (gravcomp)": []}
         self.nbody = 0
         self.njoint = 0
 
@@ -462,8 +463,8 @@ class _Bodies:
                 self.joints.append((jname, "revolute" if jtype == "hinge" else "prismatic", link, child,
                                     place[1], place[0], axis, self.joint_options(j, ja, jtype), where))
                 frame = (np.eye(3), -anchor)  # the body frame in the new link's frame
-            if float(ja.get("stiffness", 0) or 0) != 0:
-                self.unmodelled["joint springs (stiffness)"].append(jname)
+            if jtype in ("free", "ball") and float(ja.get("stiffness", 0) or 0) != 0:
+                self.unmodelled["springs of ball and free joints (stiffness)"].append(jname)
             link = child
         if not joints:  # welded to the parent
             self.links.append(_Link(name, where=doc.where(elem)))
@@ -480,6 +481,10 @@ class _Bodies:
             out[field] = doc.number(elem, a, key, 0.0)
         if jtype in ("free", "ball"):
             return out  # a ball joint's range is a cone: not a box on the dofs
+        # the spring torque -stiffness (qpos - springref); robodyn's q is MuJoCo's qpos
+        out["stiffness"] = doc.number(elem, a, "stiffness", 0.0)
+        out["spring_reference"] = doc.number(elem, a, "springref", 0.0) * (
+            np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
         limited = doc.flag(elem, a, "limited", "auto", ("true", "false", "auto"))
         if limited == "true" or (limited == "auto" and self.c.autolimits and "range" in a):
             lo, hi = doc.floats(elem, a, "range", 2, (0.0, 0.0)) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)

@@ -112,6 +112,8 @@ class _Writer:
                                  "dofs; an MJCF joint holds one value")
             if values[0]:
                 attrs += f' {key}="{numbers(values[0])}"'
+        if m.stiffness[k] or m.spring_reference[k]:  # joints of one dof only (Model checks)
+            attrs += f' stiffness="{numbers(m.stiffness[k])}" springref="{numbers(m.spring_reference[k])}"'
         self.lines.append(f"{indent}<joint {attrs}/>")
 
     def body(self, i, indent) -> None:

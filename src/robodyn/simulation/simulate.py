@@ -537,11 +537,19 @@ def _run_scipy(plant, method, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol):
             bar.update(s)
 
 
+def spring_energy(model, Q) -> np.ndarray:
+    """``sum_k stiffness_k (q_k - spring_reference_k)^2 / 2`` (...,) of configurations ``Q``
+    (..., nq): the energy stored in the joint springs (joints of one dof)."""
+    one = np.flatnonzero(J.NV[model.joint_type] == 1)
+    k, iq = model.idx_v[one], model.idx_q[one]
+    return 0.5 * ((Q[..., iq] - model.spring_reference[k]) ** 2) @ model.stiffness[k]
+
+
 def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None) -> Trajectory:
     from ..algorithms.energy import kinetic_energy, potential_energy
 
     kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
-    potential = potential_energy(model, Q)
+    potential = potential_energy(model, Q) + spring_energy(model, Q)
     lyapunov = q_d = v_d = None
     vectorized = getattr(controller, "vectorized", False) and not law.stateful
     if callable(getattr(controller, "lyapunov", None)):

@@ -20,7 +20,8 @@ class Trajectory:
     ``t`` (N,); ``q`` (N, nq); ``v``, ``a`` (N, nv) velocity and acceleration; ``tau`` (N, nv)
     the joint forces applied (the controller's command after clipping to the effort limits);
     ``kinetic``, ``potential``, ``energy`` (N,) with ``energy = kinetic + potential``
-    (kinetic energy includes the rotors' ``armature v^2 / 2``); ``lyapunov`` (N,) the
+    (kinetic energy includes the rotors' ``armature v^2 / 2``, potential energy the joint
+    springs' ``stiffness (q - spring_reference)^2 / 2``); ``lyapunov`` (N,) the
     controller's Lyapunov function or None; ``q_desired``, ``v_desired`` (N, nq) / (N, nv)
     the controller's reference or None; ``controller_state`` (N, nz) the internal state of a
     controller that has one (see :func:`robodyn.simulate`), else None.
