@@ -48,4 +48,5 @@ sphinx_gallery_conf = {
     "within_subsection_order": "FileNameSortKey",
     "show_memory": False,
     "plot_gallery": "True",
+    "run_stale_examples": True,  # every build runs every script: the gallery is a test
 }

@@ -38,6 +38,8 @@ INPUT_CASES = [
     ("identify", ["identify", "panda", "{file}"], ["missing", "directory", "empty", "binary", "columns", "log_nan"]),
     ("simulate --reference", ["simulate", "panda", "--controller", "computed-torque", "--duration", "0.01",
                               "--reference", "{file}"], ["missing", "directory", "empty", "binary", "columns", "nan"]),
+    ("view --trajectory", ["view", "panda", "--trajectory", "{file}", "--video", "{file}.gif"],
+     ["missing", "directory", "empty", "binary", "columns", "nan", "huge"]),
 ]
 
 
@@ -65,6 +67,8 @@ OUTPUT_CASES = [
     (["identify", "panda", "{traj}", "--report", "{out}"], "--report"),
     (["derive", "pendulum", "--latex", "{out}"], "--latex"),
     (["derive", "pendulum", "--c", "{out}"], "--c"),
+    (["view", "panda", "--png", "{out}"], "--png"),
+    (["view", "panda", "--trajectory", "{traj}", "--video", "{out}"], "--video"),
 ]
 
 
@@ -125,7 +129,8 @@ def test_results_of_a_good_run_are_written(tmp_path, capsys):
 
 
 MODEL_COMMANDS = [["info"], ["demo"], ["bench", "--no-compare"], ["simulate", "--duration", "0.01"],
-                  ["torques", "t.csv"], ["excite", "--out", "x.csv"], ["identify", "d.csv"], ["derive"]]
+                  ["torques", "t.csv"], ["excite", "--out", "x.csv"], ["identify", "d.csv"], ["derive"],
+                  ["view", "--png", "v.png"]]
 
 
 @pytest.mark.parametrize("command", MODEL_COMMANDS, ids=[c[0] for c in MODEL_COMMANDS])

@@ -25,7 +25,7 @@ def test_the_guide_includes_every_readme_section():
 
 
 @pytest.mark.parametrize("module", ["robodyn", "robodyn.control", "robodyn.contact", "robodyn.identification",
-                                    "robodyn.symbolic", "robodyn.interop", "robodyn.distributed"])
+                                    "robodyn.symbolic", "robodyn.interop", "robodyn.distributed", "robodyn.viewer"])
 def test_the_api_reference_lists_every_public_name(module):
     import importlib
     import types

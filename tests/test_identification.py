@@ -435,7 +435,8 @@ def test_panda_noisy_predicts_another_trajectory(method, tmp_path):
         assert_rel(rd.rnea(back, other.q, other.v, other.a), pred, 1e-9)
         paths = ident.write_report(result, log, tmp_path / "report", validation=other_noisy.__class__(
             other.t, other.q, other.v, other.a, other_noisy.tau))
-        assert {p.name for p in paths} == {"report.txt", "torques.png", "residuals.png", "singular_values.png"}
+        assert {p.name for p in paths} == {"report.txt", "torques.png", "residuals.png", "singular_values.png",
+                                           "robot.png"}
         text = paths[0].read_text()
         assert "condition number" in text and "validation data" in text and "Izz1 + Iyy2" in text
 

@@ -38,7 +38,7 @@ _LAZY_APPS = {"simulate": "simulation", "Trajectory": "simulation", "linearize":
               "rollout": "simulation", "Rollouts": "simulation", "simulation": None,
               "control": None, "plots": None, "identification": None, "symbolic": None, "interop": None,
               "contact": None, "Contacts": "contact", "inertia": None, "actuators": None,
-              "distributed": None, "simulate_many": "distributed"}
+              "distributed": None, "simulate_many": "distributed", "viewer": None}
 
 
 def __getattr__(name):

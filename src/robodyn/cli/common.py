@@ -13,7 +13,8 @@ from .. import models
 
 
 def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
-    """A built-in robot by name, a MuJoCo model (``.xml``, ``.mjcf``) or a URDF file by path."""
+    """A built-in robot by name, a MuJoCo model (``.xml``, ``.mjcf``) or a URDF file by path, or
+    a URDF of example-robot-data by its name (``solo12``) when that package is installed."""
     from ..io.mjcf import load_mjcf
     from ..io.urdf import load_urdf
 
@@ -27,7 +28,11 @@ def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
         return load_mjcf(spec, physical=physical)
     if spec.endswith(".urdf") or "/" in spec:
         return load_urdf(spec, floating_base=floating_base, physical=physical)
-    raise ValueError(f"unknown model {spec!r}: give a URDF or MJCF path or one of {models.names()}")
+    found = models.example_robot_urdf(spec)
+    if found is not None:
+        return load_urdf(found, floating_base=floating_base, physical=physical)
+    raise ValueError(f"unknown model {spec!r}: give a URDF or MJCF path, one of {models.names()}, or the name of "
+                     f"a URDF of example-robot-data (pip install example-robot-data), e.g. solo12")
 
 
 def add_model_arguments(p, default=None) -> None:

@@ -9,6 +9,7 @@
     robodyn excite MODEL ...    excitation trajectory for identification (cli/identification.py)
     robodyn identify MODEL CSV  identified parameters, URDF and report (cli/identification.py)
     robodyn derive MODEL        closed-form M, C, g (sympy), as LaTeX and C code
+    robodyn view MODEL          3-D view in the browser, or a PNG/GIF render (cli/view.py)
 
 MODEL is a built-in name (``robodyn info --list``) or the path of a URDF file.
 
@@ -28,7 +29,7 @@ import sys
 import warnings
 
 from ..errors import ModelError
-from . import common, identification, model, simulation, symbolic
+from . import common, identification, model, simulation, symbolic, view
 
 
 def main(argv=None) -> int:
@@ -36,7 +37,7 @@ def main(argv=None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
 
     parser.add_argument("--debug", action="store_true", help="show the Python traceback of an unexpected error")
-    for commands in (model, simulation, identification, symbolic):
+    for commands in (model, simulation, identification, symbolic, view):
         commands.add_commands(sub)
 
     args = parser.parse_args(argv)

@@ -34,7 +34,8 @@ def rms_per_joint(pred: np.ndarray, tau: np.ndarray) -> np.ndarray:
 def write_report(result, log: Log, directory, *, validation: Log | None = None) -> list[Path]:
     """Write the report of an :class:`~robodyn.identification.identify.Identification` on the
     log it was identified from (and optionally a ``validation`` log of another motion).
-    Returns the paths written."""
+    Writes report.txt, torques.png, residuals.png, singular_values.png and a render of the
+    robot (robot.png, :func:`robodyn.viewer.render`). Returns the paths written."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -100,4 +101,8 @@ def write_report(result, log: Log, directory, *, validation: Log | None = None) 
     paths.append(out / "singular_values.png")
     _save(fig, paths[-1])
     plt.close(fig)
+
+    from ..viewer import render  # the robot, at the middle sample of the log (capsule skeleton)
+
+    paths.append(render(model, log.q[len(log.q) // 2], out / "robot.png", size=(480, 360)))
     return paths

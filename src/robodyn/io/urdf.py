@@ -14,7 +14,8 @@ and ``<drake:gear_ratio value>``: ``rotor_inertia * gear_ratio^2``; ``write_urdf
 dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
 reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
 dynamics and is skipped without a warning (:func:`read_collisions` reads the collision
-geometry, which :func:`robodyn.contact.shapes_from_urdf` turns into contact shapes).
+geometry, which :func:`robodyn.contact.shapes_from_urdf` turns into contact shapes;
+:func:`read_visuals` the visual geometry and its colours, which :mod:`robodyn.viewer` draws).
 
 Lenient where the major loaders are: a byte-order mark or blank lines before ``<?xml ...?>``,
 a default ``xmlns`` on ``<robot>``, extension elements and attributes in other namespaces
@@ -28,19 +29,23 @@ Files are limited to ``MAX_FILE_BYTES`` bytes and ``MAX_DEPTH`` levels of nestin
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import math
 import warnings
 from collections import Counter
-from typing import NamedTuple
 
 import numpy as np
 
 from ..builder import ModelBuilder, rpy_to_matrix
 from ..errors import ModelError, RobodynWarning
 from ..model import Model
-from ._xml import MAX_DEPTH, parse, read_source
+from ._xml import MAX_DEPTH, is_xml_text, parse, read_source
 
-__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "load_urdf", "read_collisions", "Collision"]
+# ``is_xml_text(source)``: whether a source is XML text rather than a path (relative mesh
+# paths of a file start at its folder), shared with the readers of the geometry.
+__all__ = ["MAX_DEPTH", "MAX_FILE_BYTES", "load_urdf", "read_collisions", "Collision", "read_visuals", "Visual",
+           "is_xml_text"]
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
 
@@ -217,7 +222,8 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     b.add_link(lname, mass=mass, com=xyz, inertia=I, inertia_rotation=rpy_to_matrix(rpy), where=where)
 
 
-class Collision(NamedTuple):
+@dataclass(frozen=True, eq=False)
+class Collision:
     """One ``<collision>`` geometry of a URDF link: ``kind`` ``"sphere"`` (``size = (radius,)``),
     ``"box"`` (``size``: the three edges), ``"cylinder"`` (``(radius, length)``, along the
     local z axis) or ``"mesh"`` (``size = ()``, ``filename`` set); ``xyz``, ``rpy`` the
@@ -235,32 +241,103 @@ def read_collisions(source) -> list[Collision]:
     """The ``<collision>`` geometry of every link of a URDF file (path) or XML string, in
     file order, read with the safeguards of :func:`load_urdf`. A ``<collision>`` without a
     geometry, an unknown geometry, or sizes that are not positive are a :class:`ModelError`."""
+    rd, root = _parse_source(source)
+    out = []
+    for link, col, where in _link_elements(rd, root, "collision"):
+        kind, size, g = _geometry(rd, col, where)
+        xyz, rpy = rd.origin(col)
+        out.append(Collision(link.get("name"), kind, size, xyz, rpy, g.get("filename"), where))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Visual(Collision):
+    """One ``<visual>`` of a URDF link: the fields of :class:`Collision` (the geometry frame is
+    the ``<origin>`` in the link frame; a cylinder lies along its local z axis), and ``scale``
+    (3,) the ``<mesh scale>`` (ones without one; 1 for the primitives); ``rgba`` (4,) in
+    [0, 1], the ``<material>``'s ``<color>`` (inline, or the robot-level ``<material name>``
+    it refers to), or None when the file gives none (textures are not read)."""
+    scale: np.ndarray = None
+    rgba: np.ndarray | None = None
+
+
+def read_visuals(source) -> list[Visual]:
+    """The ``<visual>`` geometry of every link of a URDF file (path) or XML string, in file
+    order, read with the safeguards of :func:`load_urdf` (hardened XML, size and depth
+    limits). Drawing is forgiving where dynamics is not: a ``<visual>`` without a geometry,
+    with an unknown one, a ``<mesh>`` without a filename or sizes that are not positive finite
+    numbers is left out with a :class:`RobodynWarning` naming the link, the element and its
+    line; malformed XML is still a :class:`ModelError`."""
+    rd, root = _parse_source(source)
+    named = {}  # robot-level <material name=...><color rgba=.../></material>
+    for m in (m for m in root if m.tag == "material" and m.get("name")):
+        try:
+            if (rgba := _color(rd, m)) is not None:
+                named[m.get("name")] = rgba
+        except ModelError as e:
+            warnings.warn(f"{e}; the visuals that use it get their mesh's or the default colour",
+                          RobodynWarning, stacklevel=2)
+    out = []
+    for link, vis, where in _link_elements(rd, root, "visual"):
+        try:
+            kind, size, g = _geometry(rd, vis, where)
+            if kind == "mesh" and not g.get("filename"):
+                raise ModelError(f"{where}: <mesh> without a filename")
+            xyz, rpy = rd.origin(vis)
+            scale = rd.floats(g, "scale", 3, (1.0, 1.0, 1.0)) if kind == "mesh" else np.ones(3)
+            material = _child(vis, "material")
+            rgba = None if material is None else _color(rd, material)
+            if rgba is None and material is not None:
+                rgba = named.get(material.get("name"))
+        except ModelError as e:
+            warnings.warn(f"{e}; this visual of link {link.get('name')!r} is not drawn", RobodynWarning,
+                          stacklevel=2)
+            continue
+        out.append(Visual(link.get("name"), kind, size, xyz, rpy, g.get("filename"), where, scale, rgba))
+    return out
+
+
+def _parse_source(source) -> tuple[_Reader, object]:
+    """``(reader, root element)`` of a URDF path or XML string, hardened (:mod:`._xml`)."""
     text, name = _read_source(source)
     root, lines = parse(text, name)
-    rd = _Reader(name, lines)
-    out = []
+    return _Reader(name, lines), root
+
+
+def _link_elements(rd: _Reader, root, tag: str):
+    """``(link, element, where)`` for every child ``<tag>`` of every ``<link>``, in file order."""
     for link in root:
         if link.tag != "link":
             continue
-        for col in link:
-            if col.tag != "collision":
-                continue
-            where = rd.where(col, f"<link name={link.get('name')!r}> <collision>")
-            geometry = _child(col, "geometry")
-            shapes = [] if geometry is None else [g for g in geometry if isinstance(g.tag, str)]
-            if len(shapes) != 1:
-                raise ModelError(f"{where}: expected one geometry in <geometry>, got {len(shapes)}")
-            g = shapes[0]
-            xyz, rpy = rd.origin(col)
-            sizes = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "mesh": ()}
-            if g.tag not in sizes:
-                raise ModelError(f"{where}: unknown geometry <{g.tag}>")
-            size = (tuple(rd.floats(g, "size", 3)) if g.tag == "box"
-                    else tuple(rd.floats(g, k, 1)[0] for k in sizes[g.tag]))
-            if any(x <= 0 for x in size):
-                raise ModelError(f"{where}: <{g.tag}> sizes must be > 0, got {list(size)}")
-            out.append(Collision(link.get("name"), g.tag, size, xyz, rpy, g.get("filename"), where))
-    return out
+        for elem in link:
+            if elem.tag == tag:
+                yield link, elem, rd.where(elem, f"<link name={link.get('name')!r}> <{tag}>")
+
+
+_SIZES = {"sphere": ("radius",), "cylinder": ("radius", "length"), "box": ("size",), "mesh": ()}
+
+
+def _geometry(rd: _Reader, elem, where: str) -> tuple[str, tuple, object]:
+    """``(kind, size, geometry element)`` of the one shape in ``elem``'s ``<geometry>``
+    (:class:`Collision` describes ``kind`` and ``size``); a :class:`ModelError` otherwise."""
+    geometry = _child(elem, "geometry")
+    shapes = [] if geometry is None else [g for g in geometry if isinstance(g.tag, str)]
+    if len(shapes) != 1:
+        raise ModelError(f"{where}: expected one geometry in <geometry>, got {len(shapes)}")
+    g = shapes[0]
+    if g.tag not in _SIZES:
+        raise ModelError(f"{where}: unknown geometry <{g.tag}>")
+    size = (tuple(rd.floats(g, "size", 3)) if g.tag == "box"
+            else tuple(rd.floats(g, k, 1)[0] for k in _SIZES[g.tag]))
+    if any(x <= 0 for x in size):
+        raise ModelError(f"{where}: <{g.tag}> sizes must be > 0, got {list(size)}")
+    return g.tag, size, g
+
+
+def _color(rd: _Reader, material) -> np.ndarray | None:
+    """The ``rgba`` (4,) of a ``<material>``'s ``<color>``, clipped to [0, 1]; None without one."""
+    color = _child(material, "color")
+    return None if color is None else np.clip(rd.floats(color, "rgba", 4), 0.0, 1.0)
 
 
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}

@@ -65,4 +65,23 @@ def _build(name: str) -> Model:
     return _BUILDERS[name]()
 
 
-__all__ = ["load", "names"]
+__all__ = ["load", "names", "example_robot_urdf"]
+
+
+def example_robot_urdf(name: str):
+    """The path of ``<name>.urdf`` in the robots of example-robot-data, when that package is
+    installed (its wheel puts them under ``<site-packages>/cmeel.prefix/share/example-robot-data/
+    robots``) and exactly one file has that name; else None. ``robodyn view solo12`` and the
+    other commands find a robot by this name."""
+    import site
+    import sysconfig
+    from pathlib import Path
+
+    roots = {sysconfig.get_paths()[k] for k in ("purelib", "platlib")} | set(site.getsitepackages())
+    for root in sorted(roots):
+        robots = Path(root) / "cmeel.prefix" / "share" / "example-robot-data" / "robots"
+        if robots.is_dir():
+            hits = sorted(robots.glob(f"*/*/{name}.urdf"))
+            if len(hits) == 1:
+                return hits[0]
+    return None
