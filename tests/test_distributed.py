@@ -48,9 +48,11 @@ def test_arrays_on_the_cluster_equal_numpy_and_compile_once(client):
     lazy = [da.from_array(x, chunks=(300, -1)) for x in (q, v, a)]
     tau = rd.rnea(PANDA, *lazy)
     assert np.array_equal(client.compute(tau).result(), rd.rnea(PANDA, q, v, a))
+    # the same kernels in another process: equal up to the order of the SIMD sums, which the
+    # compiler may pick by the arrays' memory alignment (fastmath reassociation)
     got = client.gather(client.compute(list(rd.aba_derivatives(PANDA, *lazy))))
     for g, w in zip(got, rd.aba_derivatives(PANDA, q, v, a), strict=True):
-        assert np.array_equal(g, w)
+        np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-12 * np.abs(w).max())
     assert set(client.run(_signatures).values()) == {1}  # 14 tasks, no new specialisation anywhere
 
 

@@ -9,7 +9,9 @@ call returns a tuple)::
     tau.to_zarr("tau.zarr")                       # computed block by block, in parallel
 
 Each block of states is one task that calls the same function on NumPy arrays, so a block's
-result equals the in-memory call on the same states bit for bit. The leading (batch) axes may
+result equals the in-memory call on the same states: bit for bit in one process; in another
+process to the last bits where a kernel's vectorised sums may be reassociated by the compiler
+depending on the arrays' memory alignment (``aba_derivatives``; ``rnea`` is exact). The leading (batch) axes may
 be chunked in any way and broadcast as in NumPy; the trailing axes of a state (``nq``,
 ``nv``, ``(nbodies, 6)``) are brought to one chunk. The model enters the task graph once, as
 one key named after a hash of its content (``Model.__dask_tokenize__``): a distributed
