@@ -10,13 +10,13 @@ import pickle
 import numpy as np
 import pytest
 
-da = pytest.importorskip("dask.array")  # in the test extras: never skipped in CI
-import dask  # noqa: E402
+import dask
+import dask.array as da
 
-import robodyn as rd  # noqa: E402
-from robodyn import joints as J  # noqa: E402
-from robodyn._warmup import _algorithm_steps  # noqa: E402
-from robodyn.random import random_model, random_state  # noqa: E402
+import robodyn as rd
+from robodyn import joints as J
+from robodyn._warmup import _algorithm_steps
+from robodyn.random import random_model, random_state
 
 MODEL = random_model(5, seed=3, floating_base=True, branching=0.4,
                      joint_types=(J.REVOLUTE, J.PRISMATIC, J.SPHERICAL, J.HELICAL))

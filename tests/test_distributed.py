@@ -11,11 +11,11 @@ import time
 import numpy as np
 import pytest
 
-distributed = pytest.importorskip("distributed")  # in the test extras: never skipped in CI
-import dask.array as da  # noqa: E402
+import dask.array as da
+import distributed
 
-import robodyn as rd  # noqa: E402
-from robodyn.distributed import perturbed_model, simulate_many  # noqa: E402
+import robodyn as rd
+from robodyn.distributed import perturbed_model, simulate_many
 
 PANDA = rd.models.load("panda")
 Q0 = np.array([0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.7])

@@ -118,7 +118,6 @@ def test_what_cannot_hold_springs_says_so():
     model = sprung(rd.models.load("double_pendulum"))
     with pytest.warns(rd.RobodynWarning, match=r"joint springs \(stiffness, spring_reference\)"):
         rd.write_urdf(model)
-    pytest.importorskip("pinocchio")
     from robodyn.interop import to_pinocchio
 
     with pytest.warns(rd.RobodynWarning, match="joint springs of .* not converted"):

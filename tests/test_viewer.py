@@ -64,7 +64,7 @@ def test_visuals_of_example_robot_data_resolve_and_sit_on_the_right_bodies(name)
 def test_mesh_vertices_after_kinematics_agree_with_pinocchio(name):
     """The world position of every visual mesh's vertices at a random q: robodyn's forward
     kinematics and visual records against Pinocchio's visual GeometryModel placements."""
-    pin = pytest.importorskip("pinocchio")
+    import pinocchio as pin
     path, model = load(name)
     root = pin.JointModelFreeFlyer() if ROBOTS[name][1] else None
     args = (str(path), [str(SHARE)]) + ((root,) if root is not None else ())

@@ -108,7 +108,7 @@ def body_placement(jtype, row, q, iq, R, p, Rj):
 
 
 @inline
-def friction_torque(dofs, eps, q, iq, v, k):
+def passive_torque(dofs, eps, q, iq, v, k):
     """Passive joint torque opposed by the actuator at dof ``k``: friction and the joint
     spring, ``b v + Fc sgn(v) + K (q - q_ref)``.
 

@@ -37,10 +37,7 @@ def is_lazy(x) -> bool:
 def any_lazy(*xs) -> bool:
     """True when one of ``xs`` is a Dask collection: the public functions then return
     :func:`deferred` results."""
-    for x in xs:
-        if hasattr(type(x), "__dask_graph__"):
-            return True
-    return False
+    return any(is_lazy(x) for x in xs)
 
 
 def _core(model, name: str) -> tuple:

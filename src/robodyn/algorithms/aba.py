@@ -37,7 +37,7 @@ from numba import boolean
 from .._deprecated import renamed_keyword
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
-from ..joint_kernels import friction_torque, local_placement
+from ..joint_kernels import passive_torque, local_placement
 from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
                        momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
@@ -407,7 +407,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     for i in range(nb - 1, -1, -1):
         par, iv, n = ints[i, PARENT], ints[i, IV], ints[i, NDOF]
         if n == 1 and not known[iv]:
-            tau_f, axis = tau_known[iv] - friction_torque(dofs, eps, q, ints[i, IQ], v, iv), ints[i, UNIT_AXIS]
+            tau_f, axis = tau_known[iv] - passive_torque(dofs, eps, q, ints[i, IQ], v, iv), ints[i, UNIT_AXIS]
             if axis >= 3:
                 ok = articulate_single_dof(IA[i], S[iv], dofs[iv, ARMATURE], c[i], pA[i], tau_f, iv, U[iv], Dinv, u,
                                            t1, t2, 3, 6)
@@ -436,7 +436,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                     s = 0.0
                     for r in range(6):
                         s += S[k, r] * pA[i, r]
-                    u[k] = tau_known[k] - s - friction_torque(dofs, eps, q, ints[i, IQ], v, k)
+                    u[k] = tau_known[k] - s - passive_torque(dofs, eps, q, ints[i, IQ], v, k)
                 if free_root(ints, dofs, i):
                     continue  # solved in pass 3
                 if not joint_inertia(IA[i], S, dofs, iv, n, U, Dinv, G):
@@ -475,7 +475,7 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
                 s = 0.0
                 for r in range(6):
                     s += S[k, r] * t1[r]
-                tau[k] = s + dofs[k, ARMATURE] * qdd_known[k] + friction_torque(dofs, eps, q, ints[i, IQ], v, k)
+                tau[k] = s + dofs[k, ARMATURE] * qdd_known[k] + passive_torque(dofs, eps, q, ints[i, IQ], v, k)
             continue
         if n == 1:
             s = 0.0

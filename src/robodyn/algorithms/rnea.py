@@ -22,7 +22,7 @@ from numba import boolean
 from .._deprecated import renamed_keyword
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
-from ..joint_kernels import body_placement, friction_torque
+from ..joint_kernels import body_placement, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
 from ._lazy import any_lazy, deferred
@@ -160,7 +160,7 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
                 s = 0.0
                 for r in range(6):
                     s += dofs[k, MOTION + r] * f[i, r]
-            tau[k] = s + dofs[k, ARMATURE] * a[k] + friction_torque(dofs, eps, q, ints[i, IQ], v, k)
+            tau[k] = s + dofs[k, ARMATURE] * a[k] + passive_torque(dofs, eps, q, ints[i, IQ], v, k)
         if par >= 0:
             force_act(liR[i], lip[i], f[i], t1)
             for r in range(6):

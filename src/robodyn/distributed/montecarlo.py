@@ -143,7 +143,7 @@ def simulate_many(model, q0, v0, duration: float, dt: float, controller=None, *,
         options: further keywords of :func:`robodyn.simulate` (``integrator``, ``contacts``,
             ``f_ext``, ...).
     """
-    from ..simulation.simulate import positive_number
+    from ..simulation.simulate import positive_integer, positive_number
 
     q = np.asarray(q0, dtype=float)
     w = np.asarray(v0, dtype=float)
@@ -151,9 +151,7 @@ def simulate_many(model, q0, v0, duration: float, dt: float, controller=None, *,
     if runs is not None:
         if q.ndim == 2 or w.ndim == 2:
             raise ValueError("runs: give it only with single initial states q0 (nq,) and v0 (nv,)")
-        if isinstance(runs, bool) or not isinstance(runs, (int, np.integer)) or runs < 1:
-            raise ValueError(f"runs: expected a positive integer, got {runs!r}")
-        N = int(runs)
+        N = positive_integer("runs", runs)
     Q0, V0 = _initial("q0", q, model.nq, N), _initial("v0", w, model.nv, N)
     duration, dt = positive_number("duration", duration), positive_number("dt", dt)
     _perturbation(perturb)
@@ -163,10 +161,7 @@ def simulate_many(model, q0, v0, duration: float, dt: float, controller=None, *,
     if out is not None:
         Path(out).mkdir(parents=True, exist_ok=True)
     workers = len(client.scheduler_info()["workers"]) if client is not None else (os.cpu_count() or 1)
-    if chunk is None:
-        chunk = max(1, -(-N // (4 * max(workers, 1))))
-    if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
-        raise ValueError(f"chunk: expected a positive integer, got {chunk!r}")
+    chunk = max(1, -(-N // (4 * max(workers, 1)))) if chunk is None else positive_integer("chunk", chunk)
     parts = [np.arange(s, min(s + chunk, N)) for s in range(0, N, chunk)]
     fixed = (duration, dt)
     if client is None:

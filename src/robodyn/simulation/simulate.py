@@ -89,6 +89,13 @@ def positive_number(name: str, x) -> float:
     return x
 
 
+def positive_integer(name: str, x) -> int:
+    """``x`` as an int >= 1 (an integer, not a bool), or a ``ValueError`` naming ``name``."""
+    if isinstance(x, bool) or not isinstance(x, (int, np.integer)) or x < 1:
+        raise ValueError(f"{name}: expected a positive integer, got {x!r}")
+    return int(x)
+
+
 class _Law:
     """The controller as the integrators see it: ``torque(t, q, v, z)`` and the rate of its
     internal state ``z`` (empty for a stateless callable ``(t, q, v) -> tau``)."""
