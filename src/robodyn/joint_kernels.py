@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import inline
-from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, SPRING_REF, STIFFNESS, XTREE_P, XTREE_R
+from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, SPRING_REF, STIFFNESS, STRIBECK, STRIBECK_RATE, XTREE_P, XTREE_R
 from .joints import HELICAL, PLANAR, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
@@ -108,16 +108,50 @@ def body_placement(jtype, row, q, iq, R, p, Rj):
 
 
 @inline
+def coulomb_level(dofs, vk, k):
+    """The Coulomb friction level at velocity ``vk`` of dof ``k`` with the Stribeck effect,
+    ``F(v) = Fc + Fx exp(-(v / v_s)^2)``: the breakaway torque ``Fc + Fx`` at rest falling to
+    ``Fc`` as the joint speeds up (``dofs[k, STRIBECK] = Fx``, ``dofs[k, STRIBECK_RATE] =
+    1 / v_s``). Reference: Armstrong-Helouvry, Dupont & Canudas de Wit, "A survey of models,
+    analysis tools and compensation methods for the control of machines with friction",
+    Automatica 30(7), 1994."""
+    fx = dofs[k, STRIBECK]
+    if fx == 0.0:
+        return dofs[k, COULOMB]
+    x = vk * dofs[k, STRIBECK_RATE]
+    return dofs[k, COULOMB] + fx * np.exp(-x * x)
+
+
+@inline
 def passive_torque(dofs, eps, q, iq, v, k):
     """Passive joint torque opposed by the actuator at dof ``k``: friction and the joint
-    spring, ``b v + Fc sgn(v) + K (q - q_ref)``.
+    spring, ``b v + F(v) sgn(v) + K (q - q_ref)``.
 
-    ``dofs[k, DAMPING] = b`` (viscous), ``dofs[k, COULOMB] = Fc``; ``sgn`` is ``sign`` when
-    ``eps == 0`` and the smooth ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``);
-    ``dofs[k, STIFFNESS] = K``, ``dofs[k, SPRING_REF] = q_ref`` and ``q[iq]`` the joint's
-    coordinate (springs sit on joints of one dof only; ``K`` is 0 on the others, whatever
-    ``q[iq]`` then holds).
+    ``dofs[k, DAMPING] = b`` (viscous), ``F(v)`` the Coulomb level with the Stribeck effect
+    (:func:`coulomb_level`); ``sgn`` is ``sign`` when ``eps == 0`` and the smooth
+    ``tanh(v / eps)`` otherwise (``Model.coulomb_smoothing``); ``dofs[k, STIFFNESS] = K``,
+    ``dofs[k, SPRING_REF] = q_ref`` and ``q[iq]`` the joint's coordinate (springs sit on joints
+    of one dof only; ``K`` is 0 on the others, whatever ``q[iq]`` then holds).
     """
     vk = v[k]
     s = np.tanh(vk / eps) if eps > 0.0 else (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0))
-    return dofs[k, DAMPING] * vk + dofs[k, COULOMB] * s + dofs[k, STIFFNESS] * (q[iq] - dofs[k, SPRING_REF])
+    return (dofs[k, DAMPING] * vk + coulomb_level(dofs, vk, k) * s
+            + dofs[k, STIFFNESS] * (q[iq] - dofs[k, SPRING_REF]))
+
+
+@inline
+def passive_torque_dv(dofs, eps, vk, k):
+    """``d/dv`` of :func:`passive_torque` at velocity ``vk`` of dof ``k``:
+    ``b + F(v) sgn'(v) + F'(v) sgn(v)`` with ``F'(v) = -2 v / v_s^2 Fx exp(-(v / v_s)^2)``
+    (``sgn' = (1 - tanh^2) / eps`` when smoothed, 0 for the exact sign away from 0)."""
+    s, ds = (1.0 if vk > 0.0 else (-1.0 if vk < 0.0 else 0.0)), 0.0
+    if eps > 0.0:
+        s = np.tanh(vk / eps)
+        ds = (1.0 - s * s) / eps
+    out = dofs[k, DAMPING] + coulomb_level(dofs, vk, k) * ds
+    fx = dofs[k, STRIBECK]
+    if fx != 0.0:
+        r = dofs[k, STRIBECK_RATE]
+        x = vk * r
+        out -= 2.0 * x * r * fx * np.exp(-x * x) * s
+    return out

@@ -23,7 +23,9 @@ The tables (built once per model by :func:`pack`, reached as ``model.kernel``):
 ``dofs[(friction, armature)]`` (nv, DOF_COLUMNS) float, one row per dof: the motion
     subspace column in the child frame (``MOTION``, 6), then ``ARMATURE``, ``DAMPING``
     (viscous), ``COULOMB``, the joint spring's ``STIFFNESS`` (zeroed when switched off, with
-    friction) and its rest position ``SPRING_REF``.
+    friction) and its rest position ``SPRING_REF``, the Stribeck excess ``STRIBECK`` (zeroed
+    with friction) and the inverse of its velocity ``STRIBECK_RATE`` (``1 / v_s``, 0 where
+    there is none).
 ``params[with_gravity]`` (PARAMS_SIZE,): gravity (``GRAVITY``, 3, or zeros) and the Coulomb
     smoothing velocity (``SMOOTHING``).
 ``zero_wrench`` (nb, 6): no external wrench. ``multi_dof_bodies``: the bodies whose joint has several dofs (free, spherical).
@@ -54,8 +56,8 @@ INERTIA_END = INERTIA + 10
 BODY_COLUMNS = JOINT_CONSTANTS + J.JOINT_CONSTANTS_SIZE
 
 # ``dofs`` columns
-MOTION, ARMATURE, DAMPING, COULOMB, STIFFNESS, SPRING_REF = 0, 6, 7, 8, 9, 10
-DOF_COLUMNS = 11
+MOTION, ARMATURE, DAMPING, COULOMB, STIFFNESS, SPRING_REF, STRIBECK, STRIBECK_RATE = 0, 6, 7, 8, 9, 10, 11, 12
+DOF_COLUMNS = 13
 
 # ``params`` entries
 GRAVITY, SMOOTHING = 0, 3
@@ -103,6 +105,9 @@ def pack(model) -> KernelTables:
         full[k:k + Si.shape[0], MOTION:MOTION + 6] = Si
     full[:, ARMATURE], full[:, DAMPING], full[:, COULOMB] = model.armature, model.damping, model.coulomb
     full[:, STIFFNESS], full[:, SPRING_REF] = model.stiffness, model.spring_reference
+    full[:, STRIBECK] = model.stribeck
+    vs = model.stribeck_velocity
+    full[:, STRIBECK_RATE] = np.divide(1.0, vs, out=np.zeros(nv), where=vs > 0)
     for i in range(nb):
         S = full[model.idx_v[i], MOTION:MOTION + 6]
         unit = ints[i, NDOF] == 1 and np.count_nonzero(S) == 1 and S.max() == 1.0
@@ -115,6 +120,7 @@ def pack(model) -> KernelTables:
             d[:, DAMPING] *= friction
             d[:, COULOMB] *= friction
             d[:, STIFFNESS] *= friction
+            d[:, STRIBECK] *= friction
             dofs[(friction, armature)] = d
     params = {}
     for with_gravity in (True, False):

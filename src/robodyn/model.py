@@ -149,7 +149,10 @@ class Model:
     order), ``idx_q`` (nb,), ``idx_v`` (nb,).
     Per-dof arrays (nv,): ``lower``, ``upper`` (position limits of 1-dof joints, +-inf for free
     joints), ``velocity_limit``, ``effort_limit``, ``damping`` (viscous, N m s/rad), ``coulomb``
-    (N m), ``armature`` (reflected rotor inertia, kg m^2), ``stiffness`` and ``spring_reference``
+    (N m), ``stribeck`` and ``stribeck_velocity`` (the breakaway excess ``F_s - F_c`` of static
+    over Coulomb friction, N m, and its decay velocity ``v_s``: the friction
+    ``(coulomb + stribeck exp(-(v / v_s)^2)) sgn(v)``), ``armature`` (reflected rotor inertia,
+    kg m^2), ``stiffness`` and ``spring_reference``
     (joint springs ``tau = stiffness (q - spring_reference)`` opposed by the actuator, N m/rad
     or N/m; joints of one dof only). Frames (nf): ``frame_names``,
     ``frame_body`` (-1 for the world), ``frame_R`` (nf, 3, 3), ``frame_p`` (nf, 3).
@@ -160,7 +163,8 @@ class Model:
         "name", "parent", "joint_type", "joint_axis", "joint_pitch", "X_tree_R", "X_tree_p", "theta",
         "idx_q", "idx_v", "nq", "nv", "link_names", "body_joint_names", "joint_names",
         "lower", "upper", "velocity_limit", "effort_limit", "damping", "coulomb", "armature",
-        "stiffness", "spring_reference", "coulomb_smoothing", "gravity", "frame_names", "frame_body", "frame_R", "frame_p",
+        "stribeck", "stribeck_velocity", "stiffness", "spring_reference", "coulomb_smoothing", "gravity",
+        "frame_names", "frame_body", "frame_R", "frame_p",
         "physical", "kernel", "_frame_index",
     )
 
@@ -183,6 +187,8 @@ class Model:
         damping=None,
         coulomb=None,
         armature=None,
+        stribeck=None,
+        stribeck_velocity=None,
         stiffness=None,
         spring_reference=None,
         coulomb_smoothing: float = 0.0,
@@ -278,13 +284,18 @@ class Model:
         lo[free_dof], hi[free_dof] = -np.inf, np.inf
         dofs = {}
         for key, val, fill in (("velocity_limit", velocity_limit, np.inf), ("effort_limit", effort_limit, np.inf),
-                               ("damping", damping, 0.0), ("coulomb", coulomb, 0.0), ("armature", armature, 0.0)):
+                               ("damping", damping, 0.0), ("coulomb", coulomb, 0.0), ("armature", armature, 0.0),
+                               ("stribeck", stribeck, 0.0), ("stribeck_velocity", stribeck_velocity, 0.0)):
             a = arr(val, (nv,), key, fill)
             if np.any(np.isnan(a)) or np.any(a < 0):
                 raise ModelError(f"{key} must be non-negative, got {a.tolist()}")
-            if key in ("damping", "coulomb", "armature") and not np.all(np.isfinite(a)):
+            if key not in ("velocity_limit", "effort_limit") and not np.all(np.isfinite(a)):
                 raise ModelError(f"{key} must be finite, got {a.tolist()}")
             dofs[key] = a
+        no_decay = (dofs["stribeck"] > 0) & (dofs["stribeck_velocity"] == 0)
+        if np.any(no_decay):
+            raise ModelError(f"stribeck friction at dofs {np.flatnonzero(no_decay).tolist()} needs a "
+                             f"stribeck_velocity > 0 (the velocity over which it decays to the Coulomb level)")
         stiff = arr(stiffness, (nv,), "stiffness")
         if not np.all(np.isfinite(stiff)) or np.any(stiff < 0):
             raise ModelError(f"stiffness must be finite and non-negative, got {stiff.tolist()}")
@@ -418,11 +429,12 @@ class Model:
 
     def rigid(self) -> "Model":
         """The model without joint friction, springs and armature (``damping``, ``coulomb``,
-        ``stiffness`` and ``armature`` zero): its ``rnea`` is the textbook ``M(q) a + C(q, v) v +
+        ``stribeck``, ``stiffness`` and ``armature`` zero): its ``rnea`` is the textbook ``M(q) a + C(q, v) v +
         g(q)`` of the rigid bodies alone, as ``rnea(..., friction=False, armature=False)`` of
         this model."""
         zero = np.zeros(self.nv)
-        return self.replace(damping=zero, coulomb=zero, armature=zero, stiffness=zero, spring_reference=zero)
+        return self.replace(damping=zero, coulomb=zero, stribeck=zero, stribeck_velocity=zero, armature=zero,
+                            stiffness=zero, spring_reference=zero)
 
     def replace(self, **changes) -> "Model":
         """A new model with some constructor arguments changed (validated again)."""
@@ -432,7 +444,8 @@ class Model:
         kw = {k: getattr(self, k) for k in (
             "parent", "joint_type", "joint_axis", "X_tree_R", "X_tree_p", "theta", "link_names",
             "body_joint_names", "gravity", "lower", "upper", "velocity_limit", "effort_limit",
-            "damping", "coulomb", "armature", "stiffness", "spring_reference", "coulomb_smoothing", "frame_names", "frame_body",
+            "damping", "coulomb", "armature", "stribeck", "stribeck_velocity", "stiffness", "spring_reference",
+            "coulomb_smoothing", "frame_names", "frame_body",
             "frame_R", "frame_p", "name", "physical", "joint_pitch")}
         unknown = set(changes) - set(kw)
         if unknown:

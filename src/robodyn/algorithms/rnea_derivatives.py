@@ -55,7 +55,8 @@ from numba import boolean
 
 from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
-from ..layout import ARMATURE, COULOMB, DAMPING, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
+from ..joint_kernels import passive_torque_dv
+from ..layout import ARMATURE, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
                        motion_cross, wrench_to_local)
 from ._lazy import any_lazy, deferred
@@ -312,11 +313,7 @@ def derivatives_state(ints, body, dofs, params, q, v, a, fext, fcode, check, dq,
                     turn[par, r] += turn[i, r]
     eps = params[SMOOTHING]
     for k in range(nv):
-        ds = 0.0
-        if eps > 0.0:
-            th = np.tanh(v[k] / eps)
-            ds = (1.0 - th * th) / eps
-        dv[k, k] += dofs[k, DAMPING] + dofs[k, COULOMB] * ds
+        dv[k, k] += passive_torque_dv(dofs, eps, v[k], k)
         dq[k, k] += dofs[k, STIFFNESS]  # the joint spring (joints of one dof: q's tangent is q)
         if mass:
             M[k, k] += dofs[k, ARMATURE]

@@ -180,6 +180,10 @@ def to_pinocchio(model: Model):
         sprung = [model.dof_names[k] for k in np.flatnonzero(model.stiffness)]
         warnings.warn(f"to_pinocchio: joint springs of {sprung} not converted (a pinocchio.Model has none)",
                       RobodynWarning, stacklevel=2)
+    if np.any(model.stribeck != 0):
+        named = [model.dof_names[k] for k in np.flatnonzero(model.stribeck)]
+        warnings.warn(f"to_pinocchio: Stribeck friction of {named} not converted (a pinocchio.Model has none)",
+                      RobodynWarning, stacklevel=2)
     return pm
 
 

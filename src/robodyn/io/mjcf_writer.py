@@ -159,6 +159,8 @@ def write_mjcf(model, path=None) -> str:
         lost.append("effort limits (not written)")
     if model.coulomb_smoothing != 0:
         lost.append("coulomb_smoothing (not written)")
+    if np.any(model.stribeck != 0):
+        lost.append("Stribeck friction (stribeck, stribeck_velocity; frictionloss holds the Coulomb level)")
     w = _Writer(model)
     w.lines += [f"<mujoco model={quoteattr(model.name)}>", '  <compiler angle="radian" autolimits="true"/>',
                 f'  <option gravity="{numbers(model.gravity)}"/>', "  <worldbody>"]

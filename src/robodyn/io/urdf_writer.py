@@ -100,6 +100,8 @@ def write_urdf(model, path=None) -> str:
         lost.append("coulomb_smoothing")
     if np.any(model.stiffness != 0):
         lost.append("joint springs (stiffness, spring_reference)")
+    if np.any(model.stribeck != 0):
+        lost.append("Stribeck friction (stribeck, stribeck_velocity; the Coulomb level is written)")
     if np.any(model.gravity != np.array([0.0, 0.0, -9.81])):
         lost.append(f"gravity {model.gravity.tolist()} (pass it to load_urdf)")
     taken = set(model.link_names) | set(model.frame_names)
