@@ -28,6 +28,7 @@ from ..control.laws import CONSTANT
 from ..errors import RobodynWarning
 from . import _contact_step as CK
 from . import _kernels as K
+from .stiction import run_stiction
 from .trajectory import Trajectory
 
 INTEGRATORS = ("semi_implicit_euler", "rk4")
@@ -212,7 +213,7 @@ def raise_at(model, status, t, q, v, tau):
 
 def simulate(model, q0, v0, duration: float, dt: float, controller=None, integrator: str | None = None, *,
              contacts=None, f_ext=None, frame: str = "local", constraints=None, baumgarte=None,
-             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None,
+             rtol: float = 1e-8, atol: float = 1e-10, progress: bool | None = None, stiction: bool = False,
              f_ext_frame=None) -> Trajectory:
     """Simulate the robot from ``(q0, v0)`` for ``duration`` seconds, sampled every ``dt``.
 
@@ -255,6 +256,13 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             sampled into ``traj.constraint_force``. Not with contacts.
         progress: show a progress bar on stderr (None: when stderr is a terminal and the run
             has at least ``PROGRESS_STEPS`` steps).
+        stiction: exact stiction: the joints' dry friction (``coulomb`` with the Stribeck
+            effect) as a set-valued force solved at every step of ``"semi_implicit_euler"``
+            (:mod:`robodyn.simulation.stiction`): a joint stops and stays at rest exactly while
+            the torque on it stays below its breakaway level ``coulomb + stribeck``, where the
+            smooth law (``coulomb_smoothing``) creeps and the sign law chatters; the friction
+            torques are sampled into ``traj.joint_friction``. Not with contacts or
+            constraints; from Python.
 
     Returns:
         :class:`Trajectory` (t, q, v, a, tau, energies, Lyapunov function, reference).
@@ -281,8 +289,13 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
         if integrator not in (None, "semi_implicit_euler"):
             raise ValueError(f"integrator: {integrator!r} cannot step through impacts; with contacts the time "
                              f"stepping is 'semi_implicit_euler' (the default)")
+    if stiction and (integrator not in (None, "semi_implicit_euler") or contacts is not None or constraints):
+        raise ValueError("stiction: the set-valued joint friction is solved by the 'semi_implicit_euler' time "
+                         "stepping, without contacts or constraints"
+                         + (f"; got integrator {integrator!r}" if integrator not in (None, "semi_implicit_euler")
+                            else ""))
     if integrator is None:
-        integrator = "rk4" if contacts is None else "semi_implicit_euler"
+        integrator = "rk4" if contacts is None and not stiction else "semi_implicit_euler"
     if integrator not in INTEGRATORS + SCIPY_INTEGRATORS + (SYMPLECTIC,):
         raise ValueError(f"integrator: unknown {integrator!r}; choose one of "
                          f"{INTEGRATORS + (SYMPLECTIC,) + SCIPY_INTEGRATORS}")
@@ -311,7 +324,8 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if constraints and contacts is not None:
         raise ValueError("constraints: not with contacts (bilateral constraints and contacts in one solve are not "
                          "supported yet); model the contacts or the constraints alone")
-    plant, law = _Plant(model, f_ext, frame, constraints, baumgarte), _Law(controller, model)
+    dry = model.replace(coulomb=np.zeros(model.nv), stribeck=np.zeros(model.nv)) if stiction else model
+    plant, law = _Plant(dry, f_ext, frame, constraints, baumgarte), _Law(controller, model)
     if constraints:
         from ..algorithms.constrained import constrained_dynamics
 
@@ -322,8 +336,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     compiled = None
     if integrator in INTEGRATORS and not law.stateful and plant.compiled:
         compiled = (CONSTANT, None, None, None, None) if controller is None else compiled_law(controller)
-    touch = None
-    if contacts is not None:
+    touch = friction = None
+    if stiction:
+        friction = run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar)[0]
+    elif contacts is not None:
         touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar)
     elif compiled is not None:
         _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
@@ -336,7 +352,7 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     else:
         _run_scipy(plant, integrator, law, q0, v0, t, Q, V, Z, A, T, bar, rtol, atol)
     bar.close()
-    traj = _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch)
+    traj = _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch, friction)
     if constraints:
         from dataclasses import replace
 
@@ -552,7 +568,7 @@ def spring_energy(model, Q) -> np.ndarray:
     return 0.5 * ((Q[..., iq] - model.spring_reference[k]) ** 2) @ model.stiffness[k]
 
 
-def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None) -> Trajectory:
+def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None, friction=None) -> Trajectory:
     from ..algorithms.energy import kinetic_energy, potential_energy
 
     kinetic = kinetic_energy(model, Q, V) + 0.5 * (V * V) @ model.armature
@@ -575,7 +591,7 @@ def _trajectory(model, controller, law, integrator, t, Q, V, Z, A, T, touch=None
             v_d = np.array([r[1] for r in ref], dtype=float)
     return Trajectory(model=model, t=t, q=Q, v=V, a=A, tau=T, kinetic=kinetic, potential=potential,
                       energy=kinetic + potential, lyapunov=lyapunov, q_desired=q_d, v_desired=v_d,
-                      controller_state=Z if law.stateful else None, integrator=integrator,
+                      controller_state=Z if law.stateful else None, integrator=integrator, joint_friction=friction,
                       **({} if touch is None else dict(
                           contact_names=touch.names, contact_normal=touch.geometry[..., 1:],
                           contact_friction=touch.friction, contact_force=touch.force,

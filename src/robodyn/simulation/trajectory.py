@@ -34,7 +34,8 @@ class Trajectory:
     the signed distance (m, negative: penetration); ``solver_iterations`` (N,) and
     ``solver_residual`` (N,) (m/s) of the contact solve. With bilateral constraints:
     ``constraint_force`` (N, m) their forces stacked in the order given (see
-    :func:`robodyn.constrained_dynamics`).
+    :func:`robodyn.constrained_dynamics`). With ``stiction=True``: ``joint_friction`` (N, nv)
+    the joints' dry friction torques over the step that starts at the sample.
     """
 
     model: object = field(repr=False)
@@ -59,6 +60,7 @@ class Trajectory:
     solver_iterations: np.ndarray | None = None
     solver_residual: np.ndarray | None = None
     constraint_force: np.ndarray | None = None
+    joint_friction: np.ndarray | None = None
 
     @property
     def normal_force(self) -> np.ndarray | None:
@@ -85,13 +87,15 @@ class Trajectory:
         what the run has: ``lyapunov``; ``q_desired:<coordinate>``, ``v_desired:<dof>``;
         ``controller_state:<k>``; per contact pair ``contact:<pair>:fx, :fy, :fz`` (its
         force), ``:nx, :ny, :nz`` (the normal), ``:distance`` and ``:mu``, with
-        ``solver_iterations, solver_residual``; ``constraint_force:<k>``.
+        ``solver_iterations, solver_residual``; ``constraint_force:<k>``;
+        ``joint_friction:<dof>``.
         :meth:`from_csv` reads it all back."""
         extra = {"kinetic": self.kinetic, "potential": self.potential, "energy": self.energy}
         if self.lyapunov is not None:
             extra["lyapunov"] = self.lyapunov
         for name, x, names in (("q_desired", self.q_desired, self.model.q_names),
-                               ("v_desired", self.v_desired, self.model.dof_names)):
+                               ("v_desired", self.v_desired, self.model.dof_names),
+                               ("joint_friction", self.joint_friction, self.model.dof_names)):
             if x is not None:
                 extra.update({f"{name}:{n}": x[:, k] for k, n in enumerate(names)})
         for name, x in (("controller_state", self.controller_state), ("constraint_force", self.constraint_force)):
@@ -132,6 +136,7 @@ class Trajectory:
         x.pop("energy", None)
         fields = dict(lyapunov=x.pop("lyapunov", None), q_desired=block("q_desired", model.q_names),
                       v_desired=block("v_desired", model.dof_names), controller_state=numbered("controller_state"),
+                      joint_friction=block("joint_friction", model.dof_names),
                       constraint_force=numbered("constraint_force"))
         pairs = list(dict.fromkeys(k[len("contact:"):].rsplit(":", 1)[0] for k in x if k.startswith("contact:")))
         if pairs:
