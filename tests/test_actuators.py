@@ -179,3 +179,39 @@ def test_composite_tracking_of_elastic_joints():
     assert stretch["damped"][1] < 0.2 * stretch["undamped"][1], stretch
     with pytest.raises(ValueError, match="kv"):
         actuators.composite_tracking(model, ref, B, kp, kd, kv=-1.0)
+
+
+def test_gear_backlash_is_a_dead_zone_in_the_elastic_coupling():
+    """Within the gap the motor turns without moving the link; beyond it the spring pushes
+    with ``K (x - b sgn x)``; links, motors and springs conserve their energy through the
+    impacts of the teeth (no damping); Tomei's PD with the gap crossed holds the link."""
+    model = rd.models.load("double_pendulum")
+    K, B, b = 300.0, np.array([0.05, 0.05]), np.array([0.05, 0.02])
+    flex = actuators.FlexibleJoints(model, K, B, backlash=b)
+    q, v = np.array([0.3, -0.2]), np.zeros(2)
+    for x, expected in ((np.array([0.04, -0.01]), [0.0, 0.0]), (np.array([0.08, -0.05]), [K * 0.03, -K * 0.03])):
+        z = np.concatenate([q + x, np.zeros(2)])
+        np.testing.assert_allclose(flex.spring(q, v, z), expected, rtol=1e-12, atol=1e-12)
+    damped = actuators.FlexibleJoints(model, K, B, damping=2.0, backlash=b)
+    z = np.concatenate([q + np.array([0.04, -0.05]), [1.0, 1.0]])  # first joint in the gap, second in touch
+    np.testing.assert_allclose(damped.spring(q, v, z), [0.0, -K * 0.03 + 2.0], rtol=1e-12)
+    with pytest.raises(ValueError, match="backlash"):
+        actuators.FlexibleJoints(model, K, B, backlash=-0.1)
+    # free motion: the motors rattle through the gaps, the energy stays
+    q0 = np.array([0.6, -0.3])
+    run = rd.simulate(model, q0, np.zeros(2), 1.0, 2e-4, controller=flex.__class__(model, K, B, backlash=b, theta0=q0),
+                      integrator="rk4")
+    total = run.energy + np.array([flex.energy(q, v, z) for q, v, z in zip(run.q, run.v, run.controller_state)])
+    assert np.ptp(total) < 1e-6 * np.abs(total).max()
+    twist = np.abs(run.controller_state[:, :2] - run.q)
+    assert np.any(twist[:, 0] < b[0]) and np.any(twist[:, 0] > b[0])  # in the gap and in touch
+    # regulation: the set point crosses the gap on the side gravity loads
+    q_d = np.array([0.3, 0.2])
+    law = actuators.motor_pd_gravity(model, q_d, K, 500.0, 20.0, backlash=b)
+    held = actuators.FlexibleJoints(model, K, B, law, damping=10.0, backlash=b, theta0=q0)
+    run = rd.simulate(model, q0, np.zeros(2), 10.0, 2e-3, controller=held, integrator="rk4")
+    assert np.abs(run.q[-1] - q_d).max() < 1e-3
+    naive = actuators.FlexibleJoints(model, K, B, actuators.motor_pd_gravity(model, q_d, K, 500.0, 20.0),
+                                     damping=10.0, backlash=b, theta0=q0)
+    off = rd.simulate(model, q0, np.zeros(2), 10.0, 2e-3, controller=naive, integrator="rk4")
+    assert np.abs(off.q[-1] - q_d).max() > 0.5 * b.min()  # without it the link sags by the gap

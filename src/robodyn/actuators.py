@@ -128,15 +128,26 @@ class FlexibleJoints(Controller):
     :func:`motor_pd_gravity`. Large ``K`` makes the system stiff: use an implicit integrator
     (``"Radau"``) or a step well below ``sqrt(B / K)``. Reference: M. W. Spong, "Modeling and
     control of elastic joint robots", J. Dyn. Sys., Meas., Control 109 (1987).
+
+    ``backlash`` ``b`` (rad, per joint, default 0): play in the gears, a dead zone of width
+    ``2 b`` in the coupling. The teeth touch only when the twist ``x = theta - q`` leaves it,
+
+        tau = K dz(x) + D (theta' - v) [|x| > b],    dz(x) = x - b sgn(x) if |x| > b else 0,
+
+    so that the motor turns freely through the gap and the springs store ``K dz(x)^2 / 2``
+    (Nordin & Gutman, "Controlling mechanical systems with backlash: a survey", Automatica
+    38(10), 2002: the dead-zone model).
     """
 
-    def __init__(self, model, stiffness, motor_inertia, motor_law=None, *, damping=0.0, theta0=None):
+    def __init__(self, model, stiffness, motor_inertia, motor_law=None, *, damping=0.0, backlash=0.0, theta0=None):
         super().__init__(model)
         nv = model.nv
         self.K = np.broadcast_to(np.asarray(stiffness, dtype=float), (nv,)).copy()
         self.B = np.broadcast_to(np.asarray(motor_inertia, dtype=float), (nv,)).copy()
         self.D = np.broadcast_to(np.asarray(damping, dtype=float), (nv,)).copy()
-        for name, x, strict in (("stiffness", self.K, True), ("motor_inertia", self.B, True), ("damping", self.D, False)):
+        self.backlash = np.broadcast_to(np.asarray(backlash, dtype=float), (nv,)).copy()
+        for name, x, strict in (("stiffness", self.K, True), ("motor_inertia", self.B, True), ("damping", self.D, False),
+                                ("backlash", self.backlash, False)):
             if not np.all(np.isfinite(x)) or (np.any(x <= 0) if strict else np.any(x < 0)):
                 raise ValueError(f"{name}: expected finite values {'> 0' if strict else '>= 0'}, got {x.tolist()}")
         if motor_law is not None and not callable(motor_law):
@@ -145,10 +156,18 @@ class FlexibleJoints(Controller):
         theta = np.zeros(nv) if theta0 is None else np.array(theta0, dtype=float).reshape(nv)
         self.state0 = np.concatenate([theta, np.zeros(nv)])
 
+    def twist(self, q, z) -> np.ndarray:
+        """``dz(theta - q)`` (nv,): the springs' deflection beyond the backlash gap."""
+        x = z[:self.model.nv] - q
+        return x - np.clip(x, -self.backlash, self.backlash)
+
     def spring(self, q, v, z) -> np.ndarray:
-        """The joint torque the motors apply to the links, ``K (theta - q) + D (theta' - v)``."""
+        """The joint torque the motors apply to the links, ``K dz(theta - q) + D (theta' - v)``
+        (the damping while the teeth touch)."""
         n = self.model.nv
-        return self.K * (z[:n] - q) + self.D * (z[n:] - v)
+        x = z[:n] - q
+        touch = (np.abs(x) > self.backlash) | (self.backlash == 0)
+        return self.K * (x - np.clip(x, -self.backlash, self.backlash)) + self.D * (z[n:] - v) * touch
 
     def torque(self, t, q, v, z):
         return self.spring(q, v, z)
@@ -162,19 +181,21 @@ class FlexibleJoints(Controller):
         """The motors' kinetic energy and the springs' potential energy (add the links' energy
         for the whole system's)."""
         n = self.model.nv
-        return float(0.5 * self.B @ (z[n:] ** 2) + 0.5 * self.K @ ((z[:n] - q) ** 2))
+        return float(0.5 * self.B @ (z[n:] ** 2) + 0.5 * self.K @ (self.twist(q, z) ** 2))
 
 
-def motor_pd_gravity(model, q_desired, stiffness, kp, kd):
+def motor_pd_gravity(model, q_desired, stiffness, kp, kd, backlash=0.0):
     """Tomei's regulator for elastic joints (1991): ``u = Kp (theta_d - theta) - Kd theta' +
     g(q_d)`` with the motor set point ``theta_d = q_d + K^-1 g(q_d)`` (the spring then holds
     the links at ``q_d`` against gravity); globally asymptotically stable for ``Kp`` large
-    enough. A motor law for :class:`FlexibleJoints`."""
+    enough. With gear ``backlash`` ``b`` the set point also crosses the gap on the loaded side,
+    ``+ b sgn(g(q_d))``, so that the teeth carry the gravity torque. A motor law for
+    :class:`FlexibleJoints`."""
     from .algorithms.terms import gravity
 
     q_d = np.asarray(q_desired, dtype=float)
     g_d = gravity(model, q_d)
-    theta_d = q_d + g_d / np.asarray(stiffness, dtype=float)
+    theta_d = q_d + g_d / np.asarray(stiffness, dtype=float) + np.asarray(backlash, dtype=float) * np.sign(g_d)
     kp, kd = np.asarray(kp, dtype=float), np.asarray(kd, dtype=float)
     return lambda t, q, v, theta, theta_dot: kp * (theta_d - theta) - kd * theta_dot + g_d
 
