@@ -1,6 +1,9 @@
 """Interaction control (robodyn.control.interaction): under a known external wrench on the
 frame, an impedance-controlled Panda settles where the spring balances it, a displacement
-f / K and a rotation by the vector n / K (within 1 %); the rotation error is SciPy's rotation
+f / K and a rotation by the vector n / K (within 1 %); with inertia shaping its step response
+is the desired mass-spring-damper's closed form; operational-space control (Panda, full pose
+and mixed rows) and workspace computed torque (elbow arm, PUMA 560 full pose) give the task
+error e'' + Kd e' + Kp e = 0 against simulation; the rotation error is SciPy's rotation
 vector; bad input."""
 
 from __future__ import annotations
@@ -177,3 +180,194 @@ def test_workspace_computed_torque_on_a_non_redundant_arm():
     assert_rel(e, expected, 1e-6)
     with pytest.raises(ValueError, match="as many task rows as joints"):
         control.WorkspaceComputedTorque(rd.models.load("panda"), "link7", np.zeros(3), 1.0, 1.0)
+
+
+def pose_matrix(p, R):
+    T = np.eye(4)
+    T[:3, :3], T[:3, 3] = R, p
+    return T
+
+
+def critically_damped(e0, ed0, w, t):
+    """e(t) of e'' + 2 w e' + w^2 e = 0 from (e0, ed0): (e0 + (ed0 + w e0) t) exp(-w t), (N, m)."""
+    return (e0[None] + (ed0 + w * e0)[None] * t[:, None]) * np.exp(-w * t)[:, None]
+
+
+def test_operational_space_full_pose_error_dynamics_and_null_space():
+    """Six task rows on the 7-dof Panda from a pose 5 cm and 0.3 rad (about a fixed axis u)
+    away, at rest: with an exact model both the position error and the rotation vector
+    log(R_d R^T) = theta u obey e'' + Kd e' + Kp e = 0 (the rotation keeps its axis, so the
+    angle does too), to 1e-6 of the initial error; two postures in the one-dimensional null
+    space give the same task motion."""
+    model = rd.models.load("panda").rigid()
+    assert model.nv == 7
+    T0 = rd.frame_pose(model, Q0, "link7")
+    e0, u, theta0, w = np.array([0.05, -0.03, 0.04]), np.array([1.0, -2.0, 2.0]) / 3, 0.3, 8.0
+    R_d = Rotation.from_rotvec(theta0 * u).as_matrix() @ T0[:3, :3]
+    errors, q_end = [], []
+    for posture, target in ((Q0, (T0[:3, 3] + e0, R_d)), (Q0 + 0.3, pose_matrix(T0[:3, 3] + e0, R_d))):
+        ctrl = control.OperationalSpace(model, "link7", target, w * w, 2 * w, posture=posture, posture_kp=20.0,
+                                        posture_kd=5.0, rows="all")
+        run = rd.simulate(model, Q0, np.zeros(7), 0.6, 1e-3, controller=ctrl, integrator="rk4")
+        e = np.array([ctrl.error(t, q) for t, q in zip(run.t, run.q)])
+        expected = critically_damped(np.concatenate([e0, theta0 * u]), np.zeros(6), w, run.t)
+        assert_rel(e[:, :3], expected[:, :3], 1e-6 * np.abs(e0).max())
+        assert_rel(e[:, 3:], expected[:, 3:], 1e-6 * theta0)
+        assert np.abs(e[-1]).max() < 0.05 * theta0  # converging to the pose (5 % left at 0.6 s)
+        errors.append(e)
+        q_end.append(run.q[-1])
+    assert_rel(errors[0], errors[1], 1e-8)
+    assert np.abs(q_end[0] - q_end[1]).max() > 1e-2  # the postures did differ
+
+
+def test_operational_space_rows_mixing_position_and_orientation():
+    """Rows [0, 1, 5] (x, y and the rotation about z) from a moving start: x and y follow
+    e'' + Kd e' + Kp e = 0 exactly (e'(0) = -(J v0)), the z entry of log(R_d R^T) goes from
+    0.4 rad to below 1 % of it; the rows left free (z, the other rotations) are not held."""
+    model = rd.models.load("panda").rigid()
+    T0 = rd.frame_pose(model, Q0, "link7")
+    v0 = np.array([0.2, -0.1, 0.3, 0.2, -0.4, 0.3, 0.5])
+    T_d = pose_matrix(T0[:3, 3] + [0.04, -0.03, 0.05], Rotation.from_rotvec([0.2, -0.1, 0.4]).as_matrix() @ T0[:3, :3])
+    w = 8.0
+    ctrl = control.OperationalSpace(model, "link7", T_d, w * w, 2 * w, posture=Q0, posture_kp=20.0, posture_kd=5.0,
+                                    rows=[0, 1, 5])
+    run = rd.simulate(model, Q0, v0, 1.2, 1e-3, controller=ctrl, integrator="rk4")
+    e = np.array([ctrl.error(t, q) for t, q in zip(run.t, run.q)])
+    assert_rel(e[0], [0.04, -0.03, 0.4], 1e-12)
+    ed0 = -(rd.jacobian(model, Q0, "link7", "local_world_aligned") @ v0)[:2]
+    assert_rel(e[:, :2], critically_damped(e[0, :2], ed0, w, run.t), 1e-6 * 0.04)
+    assert abs(e[-1, 2]) < 0.01 * 0.4
+    p_end = rd.frame_pose(model, run.q[-1], "link7")[:3, 3]
+    assert abs(p_end[2] - T_d[2, 3]) > 0.01  # z is not a task row
+
+
+def test_workspace_computed_torque_tracks_a_pose_on_the_puma():
+    """All six rows on the (6-dof) PUMA 560: the hand follows a moving pose (a circle of
+    3 cm, a rotation oscillating by 0.3 rad about a fixed axis), starting 2 cm off and at
+    rest; the position error and the rotation vector of the orientation error both follow
+    e'' + Kd e' + Kp e = 0 (e'(0) = the target's twist), to 1e-6."""
+    model = rd.models.load("puma560").rigid()
+    assert model.nv == 6
+    q0 = np.array([0.0, np.pi / 4, np.pi, 0.0, np.pi / 4, 0.0])
+    T0 = rd.frame_pose(model, q0, "link6")
+    u, a, s, w = np.array([2.0, 1.0, -2.0]) / 3, 0.3, 0.03, 6.0
+    offset = np.array([0.02, -0.01, 0.015])
+
+    def target(t):
+        R = Rotation.from_rotvec(a * np.sin(t) * u).as_matrix() @ T0[:3, :3]
+        p = T0[:3, 3] + offset + s * np.array([np.sin(t), 0.0, 1.0 - np.cos(t)])
+        twist = np.concatenate([s * np.array([np.cos(t), 0.0, np.sin(t)]), a * np.cos(t) * u])
+        twist_dot = np.concatenate([s * np.array([-np.sin(t), 0.0, np.cos(t)]), -a * np.sin(t) * u])
+        return pose_matrix(p, R), twist, twist_dot
+
+    ctrl = control.WorkspaceComputedTorque(model, "link6", target, w * w, 2 * w, rows="all")
+    run = rd.simulate(model, q0, np.zeros(6), 1.0, 1e-3, controller=ctrl, integrator="rk4")
+    e = np.array([ctrl.error(t, q) for t, q in zip(run.t, run.q)])
+    expected = critically_damped(np.concatenate([offset, np.zeros(3)]), target(0.0)[1], w, run.t)
+    assert_rel(e[:, :3], expected[:, :3], 1e-6 * np.abs(offset).max())
+    assert_rel(e[:, 3:], expected[:, 3:], 1e-6 * a)
+    assert np.abs(e[-1, :3]).max() < 1e-3 and np.abs(e[-1, 3:]).max() < 0.02 * a
+
+
+def step_response(m, d, k, f, t):
+    """x(t) of m x'' + d x' + k x = f (underdamped, per column) from rest at 0: (N, n)."""
+    m, d, k, f = (np.atleast_1d(np.asarray(y, dtype=float)) for y in (m, d, k, f))
+    wn, z = np.sqrt(k / m), d / (2.0 * np.sqrt(k * m))
+    assert np.all(z < 1)
+    wd, t = wn * np.sqrt(1.0 - z * z), t[:, None]
+    return f / k * (1.0 - np.exp(-z * wn * t) * (np.cos(wd * t) + z * wn / wd * np.sin(wd * t)))
+
+
+def test_inertia_shaping_gives_the_desired_mass_spring_damper():
+    """Impedance with inertia shaping on the Panda (6 rows, a one-dimensional null space with
+    joint damping), a step wrench [f; n] on the hand measured by the force sensor: the
+    displacement x - x_d follows M_d x'' + D x' + K x = f per axis and the rotation (n about
+    a fixed axis, equal angular gains) I phi'' + D phi' + K phi = |n| (within 1 % of f / K;
+    about 1e-8 here), settling at f / K; a heavier M_d gives its own, slower response."""
+    model = rd.models.load("panda").rigid()
+    T0 = rd.frame_pose(model, Q0, "link7")
+    K, D = np.array([400.0, 300.0, 500.0, 20.0, 20.0, 20.0]), np.array([40.0, 30.0, 35.0, 0.6, 0.6, 0.6])
+    u, n = np.array([2.0, -1.0, 2.0]) / 3, 0.3
+    h = np.concatenate([[6.0, -4.0, 5.0], n * u])
+    wrench = np.zeros((model.nbodies, 6))
+    wrench[model.frame_index("link7")[0]] = h
+    moves = []
+    for M_d in (np.array([2.0, 2.0, 2.0, 0.02, 0.02, 0.02]), np.array([6.0, 4.0, 8.0, 0.05, 0.05, 0.05])):
+        ctrl = control.CartesianImpedance(model, "link7", T0[:3, 3], T0[:3, :3], stiffness=K, damping=D, inertia=M_d,
+                                          force=lambda t, q, v: h, joint_damping=2.0)
+        run = rd.simulate(model, Q0, np.zeros(7), 1.0, 1e-3, controller=ctrl, f_ext=wrench,
+                          frame="local_world_aligned", integrator="rk4")
+        moved = -np.array([ctrl.error(q) for q in run.q])  # x - x_d and log(R R_d^T)
+        expected = np.concatenate([step_response(M_d[:3], D[:3], K[:3], h[:3], run.t),
+                                   step_response(M_d[3], D[3], K[3], n, run.t) * u], axis=1)
+        assert_rel(moved, expected, 0.01 * np.abs(h / K).min())
+        moves.append(moved)
+    assert_rel(moves[0][-1], h / K, 0.01 * np.abs(h / K).min())  # the light one has settled
+    assert np.all(np.abs(moves[0] - moves[1]).max(axis=0) > 0.1 * np.abs(h / K))  # M_d matters, per axis
+
+
+@pytest.mark.parametrize("orientation", [False, True], ids=["position", "pose"])
+def test_inertia_shaping_law_and_the_default(orientation):
+    """At a random moving state under a wrench h_e: the frame's acceleration J a + J' v (from
+    aba with tau and J^T h_e) is M_d^-1 (K e - D J v + h_e) exactly; without inertia the
+    torques are J^T (K e - D J v) - D_q v + g as before."""
+    model = rd.models.load("panda").rigid()
+    rng = rng_for("inertia-shaping", orientation)
+    q, v = Q0 + 0.2 * rng.standard_normal(7), rng.standard_normal(7)
+    T0 = rd.frame_pose(model, Q0, "link7")
+    m = 6 if orientation else 3
+    R_d = T0[:3, :3] if orientation else None
+    h = rng.standard_normal(m)
+    K, D, M_d = 100.0 + 50.0 * rng.random(m), 5.0 + rng.random(m), 0.5 + rng.random(m)
+    ctrl = control.CartesianImpedance(model, "link7", T0[:3, 3], R_d, stiffness=K, damping=D, inertia=M_d,
+                                      force=lambda t, q, v: h, joint_damping=2.0)
+    J = rd.jacobian(model, q, "link7", "local_world_aligned")[:m]
+    a = rd.aba(model, q, v, ctrl(0.0, q, v) + J.T @ h)
+    xdd = J @ a + rd.jacobian_dot_times_v(model, q, v, "link7", "local_world_aligned")[:m]
+    e = ctrl.error(q)
+    assert_rel(xdd, (K * e - D * (J @ v) + h) / M_d, 1e-9)
+    plain = control.CartesianImpedance(model, "link7", T0[:3, 3], R_d, stiffness=K, damping=D, joint_damping=2.0)
+    assert_rel(plain(0.0, q, v), J.T @ (K * e - D * (J @ v)) - 2.0 * v + rd.gravity(model, q), 1e-12)
+
+
+def test_pose_tasks_bad_input():
+    model = rd.models.load("panda")
+    T0 = rd.frame_pose(model, Q0, "link7")
+    reflection = np.diag([1.0, 1.0, -1.0])
+    with pytest.raises(ValueError, match=r"target: expected a pose, a \(4, 4\) homogeneous matrix"):
+        control.OperationalSpace(model, "link7", T0[:3, 3], 1.0, 1.0, rows="all")
+    with pytest.raises(ValueError, match=r"target \(rotation\): expected a 3 x 3 rotation matrix"):
+        control.OperationalSpace(model, "link7", (T0[:3, 3], 2 * np.eye(3)), 1.0, 1.0, rows="all")
+    with pytest.raises(ValueError, match=r"target \(rotation\): expected a 3 x 3 rotation matrix"):
+        control.OperationalSpace(model, "link7", pose_matrix(T0[:3, 3], reflection), 1.0, 1.0, rows=[0, 5])
+    with pytest.raises(ValueError, match=r"target: expected a pose"):
+        control.OperationalSpace(model, "link7", np.eye(4) * 2, 1.0, 1.0, rows="angular")
+    with pytest.raises(ValueError, match=r"the position must be 3 finite numbers"):
+        control.OperationalSpace(model, "link7", ([0.0, np.nan, 0.0], np.eye(3)), 1.0, 1.0, rows="all")
+    with pytest.raises(ValueError, match=r"target: twist_d has shape \(3,\), expected \(6,\) \(\[p'; w\] in world"):
+        control.OperationalSpace(model, "link7", lambda t: (T0, np.zeros(3), np.zeros(3)), 1.0, 1.0, rows=[0, 1, 5])
+    with pytest.raises(ValueError, match=r"target: x_d has shape \(4, 4\), expected \(3,\)"):
+        control.OperationalSpace(model, "link7", lambda t: (T0, np.zeros(3), np.zeros(3)), 1.0, 1.0)
+    with pytest.raises(ValueError, match="orientation: expected a 3 x 3 rotation matrix"):
+        control.CartesianImpedance(model, "link7", np.zeros(3), reflection, stiffness=1.0, damping=1.0)
+    ctrl = control.OperationalSpace(model, "link7", T0, 1.0, 1.0, rows="all")
+    with pytest.raises(ValueError, match="position: the task rows .* include angular ones"):
+        ctrl.position(Q0)
+    with pytest.raises(ValueError, match="as many task rows as joints"):
+        control.WorkspaceComputedTorque(model, "link7", T0, 1.0, 1.0, rows="all")
+    with pytest.raises(ValueError, match=r"Admittance: position rows \(0-2\) only"):
+        control.Admittance(model, "link7", T0, lambda t, q, v: np.zeros(6), mass=1.0, damping=1.0, stiffness=1.0,
+                           kp=1.0, kd=1.0, rows="all")
+    sensor = lambda t, q, v: np.zeros(3)  # noqa: E731
+    for bad in (0.0, -1.0, [1.0, 0.0, 1.0], np.inf):
+        with pytest.raises(ValueError, match=r"inertia: gains must be finite and > 0"):
+            control.CartesianImpedance(model, "link7", np.zeros(3), stiffness=1.0, damping=1.0, inertia=bad,
+                                       force=sensor)
+    with pytest.raises(ValueError, match="force: inertia shaping needs the measured external wrench"):
+        control.CartesianImpedance(model, "link7", np.zeros(3), stiffness=1.0, damping=1.0, inertia=1.0)
+    with pytest.raises(ValueError, match="force: the measured wrench is used by inertia shaping only"):
+        control.CartesianImpedance(model, "link7", np.zeros(3), stiffness=1.0, damping=1.0, force=sensor)
+    ctrl = control.CartesianImpedance(model, "link7", T0[:3, 3], T0[:3, :3], stiffness=1.0, damping=1.0, inertia=1.0,
+                                      force=sensor)
+    with pytest.raises(ValueError, match=r"force: the sensor returned shape \(3,\), expected \(6,\)"):
+        ctrl(0.0, Q0, np.zeros(7))

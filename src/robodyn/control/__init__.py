@@ -9,12 +9,14 @@
 
 from .controllers import (AdaptiveSlotineLi, ComputedTorque, Controller, JointPD, PDGravity, PIDGravity, SlotineLi,
                           TaskSpacePD)
+from .constrained import ConstrainedForcePosition
 from .interaction import (Admittance, CartesianImpedance, HybridForcePosition, OperationalSpace,
                           WorkspaceComputedTorque, rotation_vector)
 from .references import PointToPoint, Sampled, cubic, quintic
 from .whole_body import WholeBodyID, whole_body_inverse_dynamics
 
 __all__ = ["Controller", "PDGravity", "PIDGravity", "ComputedTorque", "TaskSpacePD", "SlotineLi", "AdaptiveSlotineLi",
-           "JointPD", "CartesianImpedance", "HybridForcePosition", "OperationalSpace", "Admittance",
+           "JointPD", "CartesianImpedance", "HybridForcePosition", "ConstrainedForcePosition",
+           "OperationalSpace", "Admittance",
            "WorkspaceComputedTorque", "rotation_vector", "WholeBodyID", "whole_body_inverse_dynamics", "PointToPoint",
            "Sampled", "cubic", "quintic"]
