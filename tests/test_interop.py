@@ -227,10 +227,43 @@ def test_aligned_helical_joints_come_in_as_helical_joints():
     np.testing.assert_allclose(rd.rnea(model, q, v, a), pin.rnea(pm, pm.createData(), q, v, a), rtol=1e-12)
 
 
+def test_universal_joints_come_in_as_two_revolute_joints_on_a_cross_link():
+    pm = pin.Model()
+    rng = np.random.default_rng(7)
+
+    def box():  # a physical body (a random pin.Inertia may violate the triangle inequality)
+        return pin.SE3.Random().act(pin.Inertia.FromBox(rng.uniform(0.5, 2.0), *rng.uniform(0.1, 0.5, 3)))
+
+    j = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root")
+    pm.appendBodyToJoint(j, box(), pin.SE3.Identity())
+    j = pm.addJoint(j, pin.JointModelRZ(), pin.SE3.Random(), "shoulder")
+    pm.appendBodyToJoint(j, box(), pin.SE3.Identity())
+    a1, a2 = rng.normal(size=3), rng.normal(size=3)
+    u = pm.addJoint(j, pin.JointModelUniversal(a1 / np.linalg.norm(a1), a2 / np.linalg.norm(a2)), pin.SE3.Random(),
+                    "wrist")
+    pm.appendBodyToJoint(u, box(), pin.SE3.Identity())
+    j = pm.addJoint(u, pin.JointModelRY(), pin.SE3.Random(), "finger")
+    pm.appendBodyToJoint(j, box(), pin.SE3.Identity())
+    pm.addFrame(pin.Frame("tool", u, pin.SE3.Random(), pin.FrameType.OP_FRAME))
+    pm.lowerPositionLimit[8:10], pm.upperPositionLimit[8:10] = [-1.0, -0.5], [1.0, 0.5]
+    model = from_pinocchio(pm)
+    assert model.nq == pm.nq and model.nv == pm.nv and model.nbodies == 5
+    assert model.body_joint_names == ("root", "shoulder", "wrist[1]", "wrist[2]", "finger")
+    assert model.parent.tolist() == [-1, 0, 1, 2, 3] and np.all(model.theta[2] == 0)  # the massless cross link
+    np.testing.assert_array_equal(model.lower[7:9], [-1.0, -0.5])
+    data = pm.createData()
+    q = pin.randomConfiguration(pm, -np.ones(pm.nq), np.ones(pm.nq))
+    v, a = rng.normal(size=pm.nv), rng.normal(size=pm.nv)
+    np.testing.assert_allclose(rd.rnea(model, q, v, a), pin.rnea(pm, data, q, v, a), rtol=1e-11, atol=1e-11)
+    np.testing.assert_allclose(rd.crba(model, q), pin.crba(pm, data, q), rtol=1e-11, atol=1e-11)
+    pin.framesForwardKinematics(pm, data, q)
+    np.testing.assert_allclose(rd.frame_pose(model, q, "tool"), data.oMf[pm.getFrameId("tool")].homogeneous,
+                               atol=1e-12)
+
+
 @pytest.mark.parametrize("joint, kind", [
     (pin.JointModelSphericalZYX(), "JointModelSphericalZYX"),
     (pin.JointModelTranslation(), "JointModelTranslation"),
-    (pin.JointModelUniversal(np.array([1.0, 0, 0]), np.array([0, 1.0, 0])), "JointModelUniversal"),
 ])
 def test_unsupported_joint_types_are_named(joint, kind):
     pm = pin.Model()

@@ -19,8 +19,12 @@ How the two models correspond (both are trees with parents before children):
   ``JointModelRevoluteUnaligned`` (any other axis); ``prismatic`` <-> ``PX``/``PY``/``PZ`` or
   ``PrismaticUnaligned``; ``free`` <-> ``JointModelFreeFlyer`` (at the root only). Pinocchio's
   continuous joints ``RUBX``/``RUBY``/``RUBZ``/``RevoluteUnboundedUnaligned`` become unbounded
-  revolute joints (robodyn's continuous joints). Other Pinocchio joints (spherical, planar,
-  translation, universal, helical, composite, ...) and mimic joints raise ``ModelError``.
+  revolute joints (robodyn's continuous joints). ``JointModelSpherical``, ``Planar`` and helical
+  joints map to robodyn's; ``JointModelUniversal`` (``R = Rot(axis1, q1) Rot(axis2, q2)``)
+  becomes two revolute joints ``<name>[1]``, ``<name>[2]`` on a massless cross link
+  ``<link>:<name>``, as ``ModelBuilder`` builds a universal joint (same ``q``, ``v``; one body
+  more). Other Pinocchio joints (translation, spherical ZYX, composite, ...) and mimic joints
+  raise ``ModelError``.
 - ``q``: a free joint is ``[x, y, z, qx, qy, qz, qw]`` (unit quaternion, scalar last) in both,
   with ``v = [v_lin, omega]`` in the child (base) frame in both: no conversion. A continuous
   joint is ``(cos t, sin t)`` (2 entries) in Pinocchio and ``t`` in robodyn:
@@ -60,6 +64,8 @@ _PRISMATIC = ("JointModelPX", "JointModelPY", "JointModelPZ", "JointModelPrismat
 _FROM_PIN = {**dict.fromkeys(_REVOLUTE + _CONTINUOUS, J.REVOLUTE), **dict.fromkeys(_PRISMATIC, J.PRISMATIC),
              "JointModelFreeFlyer": J.FREE, "JointModelSpherical": J.SPHERICAL, "JointModelPlanar": J.PLANAR,
              **dict.fromkeys(("JointModelHX", "JointModelHY", "JointModelHZ", "JointModelHelicalUnaligned"), J.HELICAL)}
+
+UNIVERSAL = -1  # a Pinocchio universal joint: two robodyn revolute joints on a massless cross link
 
 # Symmetric per-dof bounds: robodyn field, Pinocchio's name (the upper bound in Pinocchio >= 4),
 # and the suffix of Pinocchio >= 4's separate lower bound ("lower" + suffix).
@@ -201,6 +207,10 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
             f"{source}: joint {name!r} is a mimic joint (JointModelMimic of {', '.join(map(repr, mimicked))}), "
             "which robodyn does not represent; build the Pinocchio model without mimic joints "
             "(buildModelFromUrdf(..., mimic=False)) and couple the joints with rd.CouplingConstraint")
+    if kind == "JointModelUniversal":  # R = Rot(axis1, q1) Rot(axis2, q2): two revolute joints
+        jd = jm.createData()
+        jm.calc(jd, np.zeros(2))
+        return UNIVERSAL, np.asarray(jd.S, dtype=float)[3:].T.copy(), 0.0  # S at q = 0: [0; axis1], [0; axis2]
     if kind not in _FROM_PIN:
         raise ModelError(
             f"{source}: joint {name!r} is a {kind} ({jm.nq} q, {jm.nv} v), which robodyn cannot represent; "
@@ -246,7 +256,9 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     ``RevoluteUnaligned`` -> revolute; ``RUBX``/``RUBY``/``RUBZ`` and
     ``RevoluteUnboundedUnaligned`` -> unbounded revolute, i.e. robodyn's continuous joint with one
     angle instead of ``(cos, sin)``; ``PX``/``PY``/``PZ`` and ``PrismaticUnaligned`` ->
-    prismatic; ``FreeFlyer`` at the root -> free joint, same ``q``/``v`` layout), ``inertias``,
+    prismatic; ``FreeFlyer`` at the root -> free joint, same ``q``/``v`` layout; ``Universal``
+    -> two revolute joints on a massless cross link, so that body indices after it are
+    shifted by one), ``inertias``,
     gravity (linear part), the model name, and per dof: position limits of 1-dof joints,
     ``velocityLimit``, ``effortLimit``, ``damping``, ``friction`` (Coulomb) and ``armature``
     (Pinocchio's ``+-max double`` becomes ``+-inf``). Bodies are named after their link (the
@@ -261,7 +273,7 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, as ``load_urdf``.
 
     Raises ``ModelError`` naming the joint for joint types robodyn has no counterpart of
-    (planar, translation, universal, composite, spherical ZYX, ...), mimic joints and
+    (translation, composite, spherical ZYX, ...), mimic joints and
     free flyers below the root. ``rotorInertia`` and ``rotorGearRatio`` (not used by
     Pinocchio's dynamics, which use ``armature``) are not converted: a non-zero
     ``rotorInertia`` is reported by a warning.
@@ -274,8 +286,7 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     pm = pin_model
     source = f"from_pinocchio(model {pm.name!r})"
     joints = range(1, pm.njoints)
-    jtype, axis, pitch = (zip(*(_joint_type_and_axis(pm, j, source) for j in joints)) if pm.njoints > 1
-                          else ((), (), ()))
+    kinds = [_joint_type_and_axis(pm, j, source) for j in joints]
     names, frames = _link_names_and_frames(pin, pm)
     theta = np.reshape([pm.inertias[j].toDynamicParameters() for j in joints], (len(joints), 10))
     for i, t in enumerate(theta):
@@ -285,12 +296,31 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
             if physical == "error":
                 raise ModelError(f"{e} (convert with physical='warn' to keep it anyway)") from None
             warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=2)
+    body_of = {0: -1}  # Pinocchio joint -> the robodyn body carrying its inertia
+    bodies = dict(parent=[], jtype=[], axis=[], pitch=[], R=[], p=[], theta=[], link=[], joint=[])
+
+    def add(parent, jtype, axis, pitch, R, p, th, link, joint):
+        for key, value in zip(bodies, (parent, jtype, axis, pitch, R, p, th, link, joint)):
+            bodies[key].append(value)
+        return len(bodies["parent"]) - 1
+
+    for i, (j, (jtype, axis, pitch)) in enumerate(zip(joints, kinds)):
+        X, parent = pm.jointPlacements[j], body_of[pm.parents[j]]
+        if jtype == UNIVERSAL:
+            cross = add(parent, J.REVOLUTE, axis[0], 0.0, X.rotation, X.translation, np.zeros(10),
+                        f"{names[i]}:{pm.names[j]}", f"{pm.names[j]}[1]")
+            body_of[j] = add(cross, J.REVOLUTE, axis[1], 0.0, np.eye(3), np.zeros(3), theta[i], names[i],
+                             f"{pm.names[j]}[2]")
+        else:
+            body_of[j] = add(parent, jtype, axis, pitch, X.rotation, X.translation, theta[i], names[i], pm.names[j])
 
     # position limits: the q entry of each bounded 1-dof joint (continuous and free: unbounded)
     lower, upper = np.full(pm.nv, -np.inf), np.full(pm.nv, np.inf)
     q_lower, q_upper = _from_pin_bound(pm.lowerPositionLimit), _from_pin_bound(pm.upperPositionLimit)
-    for jm in (pm.joints[j] for j in joints if pm.joints[j].shortname() in _REVOLUTE + _PRISMATIC):
-        lower[jm.idx_v], upper[jm.idx_v] = q_lower[jm.idx_q], q_upper[jm.idx_q]
+    for jm in (pm.joints[j] for j in joints if pm.joints[j].shortname() in _REVOLUTE + _PRISMATIC
+               + ("JointModelUniversal",)):
+        k, n = jm.idx_v, jm.nv  # one q entry per dof
+        lower[k:k + n], upper[k:k + n] = q_lower[jm.idx_q:jm.idx_q + n], q_upper[jm.idx_q:jm.idx_q + n]
     dofs = {field: _from_pin_bound(getattr(pm, name)) for field, name, _ in _BOUNDS}
     if np.any(np.asarray(pm.rotorInertia) != 0):
         warnings.warn(f"{source}: rotorInertia {np.asarray(pm.rotorInertia).tolist()} not converted "
@@ -300,14 +330,14 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     if np.any(gravity.angular != 0):
         warnings.warn(f"{source}: angular part {gravity.angular.tolist()} of gravity ignored",
                       RobodynWarning, stacklevel=2)
+    nb = len(bodies["parent"])
     return Model(
-        parent=[pm.parents[j] - 1 for j in joints], joint_type=jtype, joint_axis=np.reshape(axis, (-1, 3)),
-        joint_pitch=np.asarray(pitch, dtype=float),
-        X_tree_R=np.reshape([pm.jointPlacements[j].rotation for j in joints], (-1, 3, 3)),
-        X_tree_p=np.reshape([pm.jointPlacements[j].translation for j in joints], (-1, 3)),
-        theta=theta, link_names=names, body_joint_names=[pm.names[j] for j in joints],
+        parent=bodies["parent"], joint_type=bodies["jtype"], joint_axis=np.reshape(bodies["axis"], (nb, 3)),
+        joint_pitch=np.asarray(bodies["pitch"], dtype=float), X_tree_R=np.reshape(bodies["R"], (nb, 3, 3)),
+        X_tree_p=np.reshape(bodies["p"], (nb, 3)), theta=np.reshape(bodies["theta"], (nb, 10)),
+        link_names=bodies["link"], body_joint_names=bodies["joint"],
         gravity=gravity.linear, lower=lower, upper=upper, damping=pm.damping, armature=pm.armature,
-        frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
+        frame_names=[f[0] for f in frames], frame_body=[body_of[f[1] + 1] for f in frames],
         frame_R=np.reshape([f[2] for f in frames], (-1, 3, 3)), frame_p=np.reshape([f[3] for f in frames], (-1, 3)),
         name=pm.name, physical=physical, **dofs,
     )
