@@ -32,8 +32,9 @@ SDF geoms (give the body an ``<inertial>``), shell inertia, elements that genera
 (``<composite>``, ``<flexcomp>``, ``<replicate>``, ``<attach>``), global coordinates, a free
 joint below a moving body. Ignored with one :class:`~robodyn.errors.RobodynWarning` listing
 them: elements that are not the rigid-body dynamics of the tree (actuators, tendons,
-equality constraints, sensors, contact pairs, ...), springs of ball and free joints and
-gravity compensation (``gravcomp``). Springs of hinge and slide joints (``stiffness``,
+equality constraints, sensors, contact pairs, ...), springs of ball and free joints, the cone
+limits of ball joints (``range``: a bound on the rotation angle, which robodyn's box limits on
+dofs cannot hold) and gravity compensation (``gravcomp``). Springs of hinge and slide joints (``stiffness``,
 ``springref``) are the model's ``stiffness`` and ``spring_reference``. Visual elements (assets, cameras, lights) are skipped
 silently. Contacts are not part of the model.
 
@@ -319,7 +320,8 @@ class _Bodies:
         self.links: list[_Link] = [_Link("world", where=f"{doc.name}: <worldbody>")]
         self.joints: list[tuple] = []  # (name, type, parent, child, xyz, R, axis, limits, where)
         self.sites: list[tuple] = []
-        self.unmodelled = {"springs of ball and free joints (stiffness)": [], "gravity compensation (gravcomp)": []}
+        self.unmodelled = {"springs of ball and free joints (stiffness)": [], "gravity compensation (gravcomp)": [],
+                           "cone limits of ball joints (range)": []}
         self.nbody = 0
         self.njoint = 0
 
@@ -465,6 +467,8 @@ class _Bodies:
                 frame = (np.eye(3), -anchor)  # the body frame in the new link's frame
             if jtype in ("free", "ball") and float(ja.get("stiffness", 0) or 0) != 0:
                 self.unmodelled["springs of ball and free joints (stiffness)"].append(jname)
+            if jtype == "ball" and self.limited(j, ja):  # a cone on the rotation angle, not a box on dofs
+                self.unmodelled["cone limits of ball joints (range)"].append(jname)
             link = child
         if not joints:  # welded to the parent
             self.links.append(_Link(name, where=doc.where(elem)))
@@ -473,6 +477,12 @@ class _Bodies:
             link, frame = name, (np.eye(3), np.zeros(3))
         self.inertia(elem, cls, self.links[-1], frame, any(t == "free" for t in types))
         self.children(elem, link, frame, cls, world and not joints)
+
+    def limited(self, elem, a) -> bool:
+        """Whether joint ``elem`` has its ``range`` on (``limited``, or ``auto`` with
+        ``<compiler autolimits="true">`` and a range given)."""
+        limited = self.doc.flag(elem, a, "limited", "auto", ("true", "false", "auto"))
+        return limited == "true" or (limited == "auto" and self.c.autolimits and "range" in a)
 
     def joint_options(self, elem, a, jtype: str) -> dict:
         doc = self.doc
@@ -485,8 +495,7 @@ class _Bodies:
         out["stiffness"] = doc.number(elem, a, "stiffness", 0.0)
         out["spring_reference"] = doc.number(elem, a, "springref", 0.0) * (
             np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
-        limited = doc.flag(elem, a, "limited", "auto", ("true", "false", "auto"))
-        if limited == "true" or (limited == "auto" and self.c.autolimits and "range" in a):
+        if self.limited(elem, a):
             lo, hi = doc.floats(elem, a, "range", 2, (0.0, 0.0)) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
             if lo >= hi:
                 raise ModelError(f"{doc.where(elem)}: range {a.get('range')!r} must have min < max")
