@@ -16,7 +16,7 @@ import pytest
 import robodyn as rd
 from robodyn import identification as ident
 from robodyn.cli import main
-from robodyn.identification.identify import METHODS
+from robodyn.identification.identify import METHODS, nominal_parameters
 from robodyn.identification.estimation import log_cholesky, theta_jacobian, theta_of_log_cholesky
 from robodyn.joints import NQ
 from robodyn.model import check_inertial_parameters
@@ -439,6 +439,82 @@ def test_panda_noisy_predicts_another_trajectory(method, tmp_path):
                                            "robot.png"}
         text = paths[0].read_text()
         assert "condition number" in text and "validation data" in text and "Izz1 + Iyy2" in text
+
+
+# -- joint springs ----------------------------------------------------------------------------
+def _sprung_elbow():
+    """The elbow arm with friction and a spring on every joint."""
+    return rd.models.load("elbow_3r").replace(damping=[0.3, 0.2, 0.1], coulomb=[0.5, 0.4, 0.3],
+                                               stiffness=[4.0, 6.0, 2.5], spring_reference=[0.3, -0.5, 0.8])
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_sprung_arm_recovers_stiffness_and_spring_reference(method):
+    """Torques of a sprung arm along a random motion, identified from a model without springs
+    with ``stiffness=True, offset=True``: the stiffness ``K`` and, through the offsets
+    ``-K q_ref``, the springs' reference positions come back, and the identified model
+    reproduces the torques."""
+    truth = _sprung_elbow()
+    traj = ident.feasible_trajectory(truth, period=6.0, harmonics=3, samples=40, seed=3)
+    t, q, qd, qdd = traj.sample(12.0, 50.0)
+    log = ident.Log(t, q, qd, qdd, rd.rnea(truth, q, qd, qdd))
+    nominal = rd.models.load("elbow_3r")
+    result = ident.identify(nominal, log, method=method, stiffness=True, offset=True)
+    names = [f"stiffness[{n}]" for n in nominal.dof_names]
+    assert set(names) <= set(result.base.names)  # each stiffness is a base parameter by itself
+    tol = 1e-4 if method == "physical" else 1e-8
+    extra = result.extra()
+    assert list(extra) == ["damping", "coulomb", "stiffness", "offset"]
+    assert_rel(extra["stiffness"], truth.stiffness, tol, "K")
+    assert_rel(extra["offset"], -truth.stiffness * truth.spring_reference, tol, "-K q_ref")
+    model = result.identified_model()
+    assert_rel(model.stiffness, truth.stiffness, tol, "model stiffness")
+    assert_rel(model.spring_reference, truth.spring_reference, tol, "model spring_reference")
+    assert_rel(rd.rnea(model, q, qd, qdd), log.tau, tol, "torques")
+    # the nominal base parameters hold the nominal model's own springs: none here
+    rows = [result.base.names.index(n) for n in names]
+    assert_rel(result.beta_nominal[rows], np.zeros(3), 0.0)
+
+
+def test_stiffness_without_offsets_and_floating_bases():
+    """Without offset columns the identified springs rest at 0 (the estimate's ``K q``); the
+    nominal parameters hold the model's own springs; a floating base's stiffness columns are
+    zero and drop out of the base parameters."""
+    truth = _sprung_elbow().replace(spring_reference=np.zeros(3))
+    traj = ident.feasible_trajectory(truth, period=6.0, harmonics=3, samples=40, seed=4)
+    t, q, qd, qdd = traj.sample(12.0, 50.0)
+    result = ident.identify(truth, ident.Log(t, q, qd, qdd, rd.rnea(truth, q, qd, qdd)), stiffness=True)
+    assert "offset" not in result.extra()
+    model = result.identified_model()
+    assert_rel(model.stiffness, truth.stiffness, 1e-8)
+    assert_rel(model.spring_reference, np.zeros(3), 0.0)
+    assert_rel(result.estimate.beta, result.beta_nominal, 1e-8)  # the nominal model is the truth
+    sprung = _sprung_elbow()
+    base = ident.base_parameters(sprung, stiffness=True, offset=True)
+    prior = nominal_parameters(sprung, base)
+    assert_rel(prior[-3:], -sprung.stiffness * sprung.spring_reference, 0.0)
+    assert_rel(prior[-6:-3], sprung.stiffness, 0.0)
+    floating = random_model(3, seed=5, floating_base=True)
+    base = ident.base_parameters(floating, stiffness=True)
+    free = [f"stiffness[{n}]" for n in floating.dof_names[:6]]
+    joints = [f"stiffness[{n}]" for n in floating.dof_names[6:]]
+    assert set(free) <= set(base.columns) and not any(n in base.names for n in free)
+    assert set(joints) <= set(base.names)
+
+
+def test_cli_identify_stiffness(tmp_path, capsys):
+    """``robodyn identify --stiffness --offset`` identifies the springs (the URDF it writes
+    cannot hold them: a warning says so)."""
+    truth = _sprung_elbow()
+    traj = ident.feasible_trajectory(truth, period=6.0, harmonics=3, samples=40, seed=3)
+    t, q, qd, qdd = traj.sample(12.0, 50.0)
+    data = ident.write_log(tmp_path / "data.csv", truth, t, q, v=qd, a=qdd, tau=rd.rnea(truth, q, qd, qdd))
+    capsys.readouterr()
+    assert main(["identify", "elbow_3r", str(data), "--stiffness", "--offset"]) == 0
+    out = capsys.readouterr().out
+    for k, name in enumerate(truth.dof_names):
+        line = next(x for x in out.splitlines() if x.endswith(f"  stiffness[{name}]"))
+        assert abs(float(line.split()[1]) - truth.stiffness[k]) < 1e-6 * truth.stiffness[k], line
 
 
 def test_identify_errors():

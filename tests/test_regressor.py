@@ -1,7 +1,8 @@
 """Regressors (robodyn.regressor, kinetic/potential_energy_regressor): linear in the inertial
-parameters and equal to rnea and the energies on random trees, with friction, armature and
-offset columns; the power balance column by column; the pendulum in closed form; Pinocchio's
-computeJointTorqueRegressor on every example-robot-data URDF; batches and bad input."""
+parameters and equal to rnea and the energies on random trees, with friction, stiffness,
+armature and offset columns (also of the Slotine-Li regressor); the power balance column by
+column; the pendulum in closed form; Pinocchio's computeJointTorqueRegressor on every
+example-robot-data URDF; batches and bad input."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import pinocchio as pin
 import pytest
 
 import robodyn as rd
+from robodyn import joints as J
 from robodyn.algorithms.regressor import extended_parameters, extra_columns
 from conftest import erd_id
 from helpers import (G, assert_rel, check_batch, check_input_validation, input_checks, integrate, pendulum,
@@ -68,6 +70,85 @@ def test_friction_armature_and_offset_columns(model, smoothing):
     assert_rel(only[..., 10 * nb:], np.concatenate([Y[..., 10 * nb + nv:10 * nb + 2 * nv],
                                                     Y[..., 10 * nb + 3 * nv:]], axis=-1), 0.0)
     assert extra_columns(m, coulomb=True, offset=True) == names[nv:2 * nv] + names[3 * nv:]
+
+
+def one_dof(model) -> np.ndarray:
+    """(nv,) whether each dof is that of a joint of one dof (the joints that take springs)."""
+    out = np.zeros(model.nv, dtype=bool)
+    for i in range(model.nbodies):
+        out[model.idx_v[i]] = J.NV[model.joint_type[i]] == 1
+    return out
+
+
+def with_springs(model, rng):
+    """``model`` with random springs on its joints of one dof (free, spherical and planar
+    joints take none)."""
+    one = one_dof(model)
+    return model.replace(stiffness=np.where(one, rng.uniform(0.5, 5.0, model.nv), 0.0),
+                         spring_reference=np.where(one, rng.uniform(-1.0, 1.0, model.nv), 0.0))
+
+
+def joint_coordinates(model, q) -> np.ndarray:
+    """(..., nv): ``q`` of each dof of a joint of one dof, 0 on the others."""
+    out = np.zeros(q.shape[:-1] + (model.nv,))
+    for i in range(model.nbodies):
+        if J.NV[model.joint_type[i]] == 1:
+            out[..., model.idx_v[i]] = q[..., model.idx_q[i]]
+    return out
+
+
+@random_models
+def test_stiffness_columns(model):
+    """[Y, v, sgn v, q, a, 1] [theta, damping, coulomb, K, armature, -K q_ref] == rnea with
+    friction, springs and armature, floating bases and ball joints included (their dofs have
+    zero stiffness columns); the stiffness and offset blocks alone give the springs' torque."""
+    rng = rng_for(model.name, "stiffness")
+    m = with_springs(with_friction_and_armature(model, rng), rng)
+    q, v, a = states(model, "stiffness", size=3)
+    flags = dict(damping=True, coulomb=True, stiffness=True, armature=True, offset=True)
+    Y = rd.regressor(m, q, v, a, **flags)
+    nb, nv = model.nbodies, model.nv
+    assert Y.shape == (3, nv, 10 * nb + 5 * nv)
+    theta = extended_parameters(m, **flags)
+    assert_rel(theta[10 * nb + 2 * nv:10 * nb + 3 * nv], m.stiffness, 0.0)
+    assert_rel(theta[-nv:], -m.stiffness * m.spring_reference, 0.0)
+    assert_rel(Y @ theta, rd.rnea(m, q, v, a), 1e-10)
+    assert_rel(rd.regressor(m, q[1], v[1], a[1], **flags), Y[1], 0.0)  # one state: the same columns
+    cols = Y[..., 10 * nb + 2 * nv:10 * nb + 3 * nv]
+    assert_rel(cols, joint_coordinates(m, q)[:, :, None] * np.eye(nv), 0.0, "stiffness block")
+    names = extra_columns(m, **flags)
+    assert len(names) == 5 * nv and names[2 * nv:3 * nv] == [f"stiffness[{n}]" for n in m.dof_names]
+    springs = rd.regressor(m, q, v, a, stiffness=True, offset=True)[..., 10 * nb:]
+    K = extended_parameters(m, stiffness=True, offset=True)[10 * nb:]
+    no_friction = m.replace(damping=np.zeros(nv), coulomb=np.zeros(nv))
+    assert_rel(springs @ K, rd.rnea(no_friction, q, v, a) - rd.rnea(m, q, v, a, friction=False), 1e-10, "springs")
+    # offsets given as numbers: the joint torque offsets as before; False is None
+    offset = rng.standard_normal(nv)
+    assert_rel(Y @ extended_parameters(m, **{**flags, "offset": offset}),
+               rd.rnea(m, q, v, a) + m.stiffness * m.spring_reference + offset, 1e-10, "offset array")
+    assert_rel(extended_parameters(m, offset=False), m.inertial_parameters(), 0.0)
+    with pytest.raises(ValueError, match=rf"offset: expected True, None or shape \({nv},\)"):
+        extended_parameters(m, offset=np.zeros(nv + 1))
+
+
+@random_models
+def test_slotine_li_stiffness_columns(model):
+    """The Slotine-Li regressor's stiffness columns: ``Y @ extended_parameters(...) ==
+    rnea(q, qd, qdd_r) - C (qd - qd_r)`` with springs (at ``q``), friction and armature."""
+    rng = rng_for(model.name, "sl-stiffness")
+    m = with_springs(with_friction_and_armature(model, rng, 0.3), rng)
+    q, v, a_r = states(model, "sl-stiffness", size=3)
+    _, v_r, _ = states(model, "sl-stiffness", "reference", size=3)
+    flags = dict(damping=True, coulomb=True, stiffness=True, armature=True, offset=True)
+    Y = rd.slotine_li_regressor(m, q, v, v_r, a_r, **flags)
+    C = rd.coriolis_matrix(m, q, v)
+    expected = rd.rnea(m, q, v, a_r) - np.einsum("...ij,...j->...i", C, v - v_r)
+    assert_rel(Y @ extended_parameters(m, **flags), expected, 1e-10)
+    nb, nv = model.nbodies, model.nv
+    stiffness = slice(10 * nb + 2 * nv, 10 * nb + 3 * nv)
+    assert_rel(Y[..., stiffness], rd.regressor(m, q, v, a_r, **flags)[..., stiffness], 0.0, "the same q columns")
+    assert_rel(rd.slotine_li_regressor(m, q, v, v, a_r, **flags), rd.regressor(m, q, v, a_r, **flags), 1e-10,
+               "qd_r = qd")
 
 
 @random_models

@@ -4,6 +4,7 @@ other, and the generated code (NumPy, Numba, C) against the numeric kernels."""
 from __future__ import annotations
 
 import ctypes
+import inspect
 import shutil
 import subprocess
 import sys
@@ -49,7 +50,7 @@ def test_generated_functions_match_numeric_kernels(derived, name):
     assert_rel(f["M"](q), rd.crba(model, q), 1e-10, "M")
     assert_rel(f["C"](q, v), rd.coriolis_matrix(model, q, v), 1e-10, "C")
     assert_rel(f["g"](q), rd.gravity(model, q), 1e-10, "g")
-    assert_rel(f["tau"](q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
+    assert_rel(f["tau"](q, v, a), rd.rnea(model, q, v, a), 1e-10, "tau")
     rotor = 0.5 * np.einsum("k,bk,bk->b", model.armature, v, v)
     assert_rel(f["T"](q, v), rd.kinetic_energy(model, q, v) + rotor, 1e-10, "T")
     assert_rel(f["U"](q), rd.potential_energy(model, q), 1e-10, "U")
@@ -73,7 +74,7 @@ def test_numba_functions(derived):
     assert_rel(M(q[3]), rd.crba(model, q[3]), 1e-10, "M, one state")
     assert_rel(C(q, v), rd.coriolis_matrix(model, q, v), 1e-10, "C")
     assert_rel(tau(q.reshape(4, 4, 3), v.reshape(4, 4, 3), a.reshape(4, 4, 3)),
-               rd.rnea(model, q, v, a, friction=False).reshape(4, 4, 3), 1e-10, "tau, 2-d batch")
+               rd.rnea(model, q, v, a).reshape(4, 4, 3), 1e-10, "tau, 2-d batch")
 
 
 def compile_c(files: dict, directory, name):
@@ -107,7 +108,7 @@ def test_c_code_compiles_and_matches(derived, name, tmp_path):
         assert_rel(call_c(lib[f"{name}_M"], n * n, q).reshape(n, n), rd.crba(model, q), 1e-10, "M")
         assert_rel(call_c(lib[f"{name}_C"], n * n, q, v).reshape(n, n), rd.coriolis_matrix(model, q, v), 1e-10, "C")
         assert_rel(call_c(lib[f"{name}_g"], n, q), rd.gravity(model, q), 1e-10, "g")
-        assert_rel(call_c(lib[f"{name}_tau"], n, q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
+        assert_rel(call_c(lib[f"{name}_tau"], n, q, v, a), rd.rnea(model, q, v, a), 1e-10, "tau")
 
 
 # -- generated code of the recursions -------------------------------------------------------
@@ -130,7 +131,7 @@ def numeric_terms(model, q, v, a):
     """The recursive terms by the numeric kernels: M, C v, g, tau."""
     g = rd.gravity(model, q)
     return {"M": rd.crba(model, q), "C_v": rd.rnea(model, q, v, 0 * v, friction=False) - g, "g": g,
-            "tau": rd.rnea(model, q, v, a, friction=False)}
+            "tau": rd.rnea(model, q, v, a)}
 
 
 def inputs(term, q, v, a):
@@ -178,7 +179,7 @@ def test_recursive_numba_inputs(recursive):
     tau = rec.to_numba("tau")
     assert_rel(tau(q, v, a), expected["tau"], 1e-12, "tau")
     q0, v0 = np.broadcast_to(q[0], q.shape), np.broadcast_to(v[0], v.shape)
-    assert_rel(tau(q[0], v[0], a), rd.rnea(model, q0, v0, a, friction=False), 1e-12, "tau, broadcast")
+    assert_rel(tau(q[0], v[0], a), rd.rnea(model, q0, v0, a), 1e-12, "tau, broadcast")
     with pytest.raises(ValueError, match=r"a: expected shape \(\.\.\., 4\), got \(3,\)"):
         tau(q[0], v[0], a[0, :3])
     assert_rel(rec.to_numba("C_v")(q[2], v[2]), expected["C_v"][2], 1e-12, "C_v, one state")
@@ -442,7 +443,7 @@ def test_prismatic_joints_on_a_random_tree():
         q, v, a = random_states(model, 4, seed)
         assert_rel(eom.to_function("M")(q), rd.crba(model, q), 1e-9, "M")
         assert_rel(eom.to_function("C")(q, v), rd.coriolis_matrix(model, q, v), 1e-9, "C")
-        assert_rel(eom.to_function("tau")(q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-9, "tau")
+        assert_rel(eom.to_function("tau")(q, v, a), rd.rnea(model, q, v, a), 1e-9, "tau")
 
 
 # -- regressor ----------------------------------------------------------------------------
@@ -459,6 +460,217 @@ def test_regressor(name):
     # linear in theta: Y itself does not contain the parameters
     assert not (reg.Y.free_symbols & set(reg.theta))
     assert reg.Y.shape == (model.nv, 10 * model.nbodies)
+
+
+# -- passive forces: friction and joint springs ---------------------------------------------
+PASSIVE_ROBOTS = ["pendulum", "double_pendulum", "planar_2r", "elbow_3r", "scara", "puma560"]
+
+
+def with_passive_forces(model, smoothing=0.0):
+    """``model`` with random damping, Coulomb friction, springs and armature on every joint."""
+    rng = rng_for(model.name, "passive", smoothing)
+    n = model.nv
+    return model.replace(damping=rng.uniform(0.1, 1.0, n), coulomb=rng.uniform(0.1, 1.0, n),
+                         stiffness=rng.uniform(0.5, 5.0, n), spring_reference=rng.uniform(-1.0, 1.0, n),
+                         armature=rng.uniform(0.01, 0.1, n), coulomb_smoothing=smoothing)
+
+
+def spring_energy(model, q):
+    """``sum_k K_k (q_k - q_ref_k)^2 / 2`` (joints of one dof), written out here."""
+    return 0.5 * np.sum(model.stiffness * (q - model.spring_reference) ** 2, axis=-1)
+
+
+@pytest.mark.parametrize("smoothing", [0.0, 0.05])
+@pytest.mark.parametrize("name", PASSIVE_ROBOTS)
+def test_passive_forces_match_numeric_rnea(name, smoothing):
+    """Damping, Coulomb friction (sign or tanh), springs and armature: ``tau``, ``tau_p`` and
+    ``U`` of both routes, as sympy expressions and as generated code of both forms, equal the
+    numeric kernels (``rnea`` with friction on, the springs' energy)."""
+    model = with_passive_forces(rd.models.load(name), smoothing)
+    q, v, a = random_states(model, 6, "passive", smoothing)
+    v[0, 0] = 0.0  # sgn(0) = 0, as the numeric kernel
+    tau = rd.rnea(model, q, v, a)
+    expected = {"tau": tau, "tau_p": tau - rd.rnea(model, q, v, a, friction=False),
+                "U": rd.potential_energy(model, q) + spring_energy(model, q)}
+    eoms = {method: S.equations_of_motion(model, method) for method in ("lagrange", "newton_euler")}
+    for method, eom in eoms.items():
+        for form in ("auto", "expanded"):
+            assert_rel(eom.to_function("tau", form)(q, v, a), expected["tau"], 1e-10, f"tau ({method}, {form})")
+        assert_rel(eom.to_function("tau_p")(q, v), expected["tau_p"], 1e-10, f"tau_p ({method})")
+        assert_rel(eom.to_function("U")(q), expected["U"], 1e-10, f"U ({method})")
+        assert_rel(eom.to_function("g")(q), rd.gravity(model, q), 1e-10, f"g ({method}): gravity alone")
+        for term in ("tau", "tau_p", "U", "L"):
+            assert eom.equals(eoms["lagrange"], term), (method, term)
+    eom = eoms["lagrange"]
+    assert eom.tau_p.has(sp.tanh if smoothing else sp.sign)
+    # the sympy expressions themselves (the term sums as printed)
+    tau = sp.lambdify([eom.q, eom.v, eom.a], eom.tau, "numpy")
+    U = sp.lambdify([eom.q], eom.U, "numpy")
+    for k in range(2):
+        assert_rel(np.ravel(tau(q[k], v[k], a[k])), expected["tau"][k], 1e-10, "tau, sympy")
+        assert_rel(U(q[k]), expected["U"][k], 1e-10, "U, sympy")
+    # Numba, and the recursions without the derivation
+    assert_rel(eom.to_numba("tau")(q, v, a), expected["tau"], 1e-10, "tau, numba")
+    assert_rel(eom.to_numba("tau")(q[0], v[0], a[0]), expected["tau"][0], 1e-10, "tau, numba, one state")
+    rec = S.recursive_dynamics(model)
+    assert_rel(rec.to_function("tau")(q, v, a), expected["tau"], 1e-10, "tau, recursive_dynamics")
+    assert_rel(rec.to_numba("tau_p")(q, v), expected["tau_p"], 1e-10, "tau_p, recursive_dynamics")
+
+
+def test_friction_switch_as_numeric_rnea():
+    """``friction=False`` leaves the passive forces and the springs' energy out, as ``rnea``'s
+    switch; the armature stays in ``M``."""
+    model = with_passive_forces(rd.models.load("elbow_3r"))
+    q, v, a = random_states(model, 5, "switch")
+    eom = S.equations_of_motion(model, friction=False)
+    assert not eom.friction and "friction=False" in repr(eom)
+    assert eom.tau_p == sp.zeros(3, 1)
+    assert_rel(eom.to_function("tau")(q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau")
+    assert_rel(eom.to_function("U")(q), rd.potential_energy(model, q), 1e-10, "U without springs")
+    assert_rel(eom.to_function("M")(q), rd.crba(model, q), 1e-10, "M with armature")
+    rec = S.recursive_dynamics(model, friction=False)
+    assert_rel(rec.to_numba("tau")(q, v, a), rd.rnea(model, q, v, a, friction=False), 1e-10, "tau, recursive")
+    assert "friction=False" in rec.program("tau").doc and "friction=False" in rec.to_c()["elbow_3r_dynamics.h"]
+    assert S.equations_of_motion(model).tau - eom.tau == S.equations_of_motion(model).tau_p
+
+
+def test_spring_energy_in_the_potential():
+    """``U`` includes ``K (q - q_ref)^2 / 2`` with symbols: ``dU/dq = g + K (q - q_ref)``, and
+    along a simulated motion ``U`` is the trajectory's potential energy."""
+    K1, K2, r1_, r2_, b1, F2 = sp.symbols("K1 K2 qr1 qr2 b1 F2", positive=True)
+    arm, _ = planar_2r_symbolic()
+    arm = arm.replace(stiffness=(K1, K2), spring_reference=(r1_, -r2_), damping=(b1, 0), coulomb=(0, F2))
+    eom = S.equations_of_motion(arm)
+    q1, q2 = eom.q
+    qd1, qd2 = eom.v
+    assert sp.expand(eom.tau_p[0] - (b1 * qd1 + K1 * (q1 - r1_))) == 0
+    assert sp.expand(eom.tau_p[1] - (F2 * sp.sign(qd2) + K2 * (q2 + r2_))) == 0
+    springs = K1 * (q1 - r1_) ** 2 / 2 + K2 * (q2 + r2_) ** 2 / 2
+    for k, (K, ref) in enumerate(((K1, r1_), (K2, -r2_))):
+        assert sp.simplify(sp.diff(eom.U, eom.q[k]) - eom.g[k] - K * (eom.q[k] - ref)) == 0
+    assert sp.simplify(eom.U - springs - S.equations_of_motion(arm, friction=False).U) == 0
+    assert {K1, K2, r1_, r2_, b1, F2} <= set(eom.parameters)
+    # numbers: a sprung, damped arm simulated by robodyn, its potential along the motion
+    model = rd.models.load("planar_2r").replace(stiffness=[3.0, 2.0], spring_reference=[0.4, -0.3], damping=[0.5, 0.5])
+    traj = rd.simulate(model, np.array([0.2, 0.1]), np.zeros(2), 0.05, 0.01)
+    U = S.equations_of_motion(model).to_function("U")
+    assert_rel(U(traj.q), traj.potential, 1e-10, "U along a trajectory")
+
+
+def test_builder_passive_keywords():
+    """The symbolic builder takes armature, damping, Coulomb friction and springs per joint
+    (symbols or numbers); the generated code with their values as parameters equals the
+    numeric builder's model."""
+    m1, m2, b, F, K, r = sp.symbols("m1 m2 b F K r", positive=True)
+    sb = S.ModelBuilder("arm", gravity=(0, -sp.Rational(981, 100), 0), coulomb_smoothing=sp.Rational(1, 20))
+    sb.add_link("link1", mass=m1, com=(0.5, 0, 0), inertia=rd.inertia.rod(m1, 1, "x"))
+    sb.add_link("link2", mass=m2, com=(0.4, 0, 0), inertia=rd.inertia.rod(m2, sp.Rational(4, 5), "x"))
+    sb.add_joint("joint1", "revolute", "world", "link1", axis=(0, 0, 1), damping=b, coulomb=F, stiffness=K,
+                 spring_reference=-r)
+    sb.add_joint("joint2", "prismatic", "link1", "link2", xyz=(1, 0, 0), axis=(1, 0, 0), armature=0.02,
+                 damping=0.3, stiffness=4, spring_reference=0.1)
+    model = sb.build()
+    assert model.damping == (b, sp.Rational(3, 10)) and model.coulomb == (F, 0)
+    assert model.stiffness == (K, 4) and model.spring_reference == (-r, sp.Rational(1, 10))
+    assert model.armature == (0, sp.Rational(1, 50)) and model.coulomb_smoothing == sp.Rational(1, 20)
+    eom = S.equations_of_motion(model)
+    assert [s.name for s in eom.parameters] == ["F", "K", "b", "m1", "m2", "r"]
+    nb = rd.ModelBuilder("arm", gravity=(0, -9.81, 0))
+    nb.add_link("link1", mass=2.0, com=(0.5, 0, 0), inertia=rd.inertia.rod(2.0, 1.0, "x"))
+    nb.add_link("link2", mass=1.5, com=(0.4, 0, 0), inertia=rd.inertia.rod(1.5, 0.8, "x"))
+    nb.add_joint("joint1", "revolute", "world", "link1", axis=(0, 0, 1), damping=0.7, friction=0.4, stiffness=2.5,
+                 spring_reference=-0.6)
+    nb.add_joint("joint2", "prismatic", "link1", "link2", xyz=(1, 0, 0), axis=(1, 0, 0), armature=0.02, damping=0.3,
+                 stiffness=4.0, spring_reference=0.1)
+    numeric = nb.build().replace(coulomb_smoothing=0.05)
+    params = np.array([0.4, 2.5, 0.7, 2.0, 1.5, 0.6])
+    q, v, a = random_states(numeric, 5, "builder")
+    for form in ("auto", "expanded"):
+        assert_rel(eom.to_function("tau", form)(q, v, a, params), rd.rnea(numeric, q, v, a), 1e-12, f"tau ({form})")
+    assert_rel(eom.to_function("U")(q, params),
+               rd.potential_energy(numeric, q) + spring_energy(numeric, q), 1e-12, "U")
+    # the regressor leaves them out: its parameters are those of the geometry only
+    assert not set(S.regressor(model).parameters) & {b, F, K, r}
+
+
+def test_passive_input_errors():
+    """Negative or non-finite friction, stiffness, armature or smoothing, or a negative symbol,
+    are refused as the numeric model refuses them, naming the field."""
+    from robodyn.errors import ModelError
+
+    with pytest.raises(ModelError, match="stiffness must be finite and non-negative"):
+        rd.models.load("planar_2r").replace(stiffness=[-1.0, 0.0])  # the numeric model's check
+    arm, _ = planar_2r_symbolic()
+    for field, value, match in (("stiffness", (-1, 0), r"stiffness\[0\] must be non-negative"),
+                                ("damping", (0, -0.5), r"damping\[1\] must be non-negative"),
+                                ("coulomb", (sp.Symbol("c", negative=True), 0), r"coulomb\[0\] must be non-negative"),
+                                ("spring_reference", (0, float("inf")), r"spring_reference\[1\]: expected a finite"),
+                                ("spring_reference", (sp.oo, 0), r"spring_reference\[0\] must be finite"),
+                                ("stiffness", (1, 2, 3), "stiffness: expected 2 entries"),
+                                ("coulomb_smoothing", -0.1, "coulomb_smoothing must be non-negative"),
+                                ("armature", (0, -1), r"armature\[1\] must be non-negative")):
+        with pytest.raises(ModelError, match=match):
+            arm.replace(**{field: value})
+    arm.replace(spring_reference=(-1, 2), stiffness=(sp.Symbol("k"), 0))  # a negative reference, a free symbol
+    b = S.ModelBuilder("bad")
+    b.add_link("link", mass=1)
+    with pytest.raises(ModelError, match=r"joint 'j': stiffness must be non-negative, got -2"):
+        b.add_joint("j", "revolute", "world", "link", axis=(0, 0, 1), stiffness=-2)
+    with pytest.raises(ModelError, match=r"joint 'j': damping must be finite"):
+        b.add_joint("j", "revolute", "world", "link", axis=(0, 0, 1), damping=sp.oo)
+    with pytest.raises(ModelError, match="a fixed joint has no armature, friction or spring"):
+        b.add_joint("j", "fixed", "world", "link", stiffness=1)
+    with pytest.raises(ModelError, match="coulomb_smoothing must be non-negative"):
+        S.ModelBuilder("bad", coulomb_smoothing=-1)
+
+
+def test_dc_motor_plant_closed_forms():
+    """A geared DC motor on every joint (``DCMotor.plant``: armature ``N^2 J_m``, damping
+    ``N^2 B_m``, Coulomb ``N F_c``): the closed forms of the plant are its numeric rnea."""
+    motor = rd.actuators.DCMotor(torque_constant=0.05, back_emf=0.05, resistance=1.0, inductance=1e-3,
+                                 gear_ratio=[50.0, 30.0, 20.0], rotor_inertia=1e-5, viscous=2e-5, coulomb=0.01)
+    plant = motor.plant(rd.models.load("elbow_3r"))
+    assert np.all(plant.armature > 0) and np.all(plant.damping > 0) and np.all(plant.coulomb > 0)
+    eom = S.equations_of_motion(S.from_model(plant))
+    q, v, a = random_states(plant, 8, "dc motor")
+    for form in ("auto", "expanded"):
+        assert_rel(eom.to_function("tau", form)(q, v, a), rd.rnea(plant, q, v, a), 1e-10, f"tau ({form})")
+    assert_rel(eom.to_function("M")(q), rd.crba(plant, q), 1e-10, "M")
+
+
+@pytest.mark.skipif("stribeck" not in inspect.signature(rd.Model).parameters,
+                    reason="the numeric model has no Stribeck friction")
+def test_stribeck_friction_is_reported_not_dropped_silently():
+    from robodyn.errors import RobodynWarning
+
+    model = rd.models.load("planar_2r").replace(stribeck=[0.5, 0.0], stribeck_velocity=[0.1, 0.0])
+    with pytest.warns(RobodynWarning, match=r"Stribeck friction of dofs \[0\]"):
+        S.from_model(model)
+
+
+def test_passive_latex_and_c_code(tmp_path):
+    """The LaTeX document has the passive forces (sign of the velocities, springs) and the
+    generated C code of ``tau`` and ``tau_p`` computes them as the numeric rnea."""
+    model = with_passive_forces(rd.models.load("planar_2r"))
+    eom = S.equations_of_motion(model)
+    doc = eom.latex()
+    assert "Passive joint forces" in doc and r"\tau_p(q, \dot q) = \tau" in doc
+    assert r"\operatorname{sign}{\left(\dot{q}_{1} \right)}" in eom.latex("tau_p")
+    assert r"\tau_{p,2} &=" in eom.latex("tau_p")
+    assert "Passive joint forces" not in S.equations_of_motion(rd.models.load("planar_2r")).latex()
+    for form in ("auto", "expanded"):
+        directory = tmp_path / form
+        files = eom.to_c(directory, terms=("tau", "tau_p"), form=form)
+        assert "tau_p: the joints' friction and springs" in files["planar_2r_dynamics.h"]
+        lib = compile_c(files, directory, f"passive_{form}")
+        q, v, a = random_states(model, 3, "passive c")
+        v[0, 1] = 0.0
+        for k in range(3):
+            assert_rel(call_c(lib.planar_2r_tau, 2, q[k], v[k], a[k]), rd.rnea(model, q[k], v[k], a[k]), 1e-12,
+                       f"tau ({form})")
+            assert_rel(call_c(lib.planar_2r_tau_p, 2, q[k], v[k]),
+                       rd.rnea(model, q[k], v[k], a[k]) - rd.rnea(model, q[k], v[k], a[k], friction=False), 1e-12,
+                       f"tau_p ({form})")
 
 
 # -- LaTeX, CLI, import ---------------------------------------------------------------------

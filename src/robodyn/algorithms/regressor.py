@@ -26,11 +26,17 @@ in this order, ``nv`` columns each (column ``k`` of a block acts on dof ``k`` on
     damping    v_k                 (parameter: ``model.damping[k]``, viscous friction)
     coulomb    sgn(v_k)            (``model.coulomb[k]``; ``tanh(v_k / eps)`` when
                                     ``model.coulomb_smoothing = eps > 0``, as in ``rnea``)
+    stiffness  q_k                 (``model.stiffness[k]``, the joint spring; ``q_k`` the
+                                    joint's coordinate; 0 on the dofs of free, spherical and
+                                    planar joints, which have no spring)
     armature   a_k                 (``model.armature[k]``)
     offset     1                   (a constant torque offset of the joint)
 
-so that ``Y @ concatenate([theta, damping, coulomb, armature]) == rnea(q, v, a)`` with
-friction and armature on (see :func:`extended_parameters`).
+so that ``Y @ concatenate([theta, damping, coulomb, stiffness, armature, offset]) ==
+rnea(q, v, a)`` with friction and armature on and ``offset = -stiffness * spring_reference``:
+the spring's torque ``K (q - q_ref)`` is linear in ``K`` and in the constant ``-K q_ref``,
+which the offset block absorbs (together with any real torque offset of the joint; see
+:func:`extended_parameters`).
 
 Pinocchio's ``computeJointTorqueRegressor`` has the same columns in the same order: its
 dynamic parameters per joint, ``[m, m c, Ixx, Ixy, Iyy, Ixz, Iyz, Izz]`` with the inertia
@@ -44,7 +50,7 @@ import numpy as np
 
 from .._deprecated import renamed_keywords
 from .._jit import core, inline, kernel
-from ..layout import IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
+from ..layout import IQ, IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
 from ._lazy import any_lazy, deferred
 from . import _inputs
@@ -54,7 +60,7 @@ from .kinematics import poses_checked
 from .rnea import base_acceleration, motion_pass
 from .driver import batch_kernel, chunks
 
-EXTRA_COLUMNS = ("damping", "coulomb", "armature", "offset")
+EXTRA_COLUMNS = ("damping", "coulomb", "stiffness", "armature", "offset")
 # The flags of the extra columns follow the model's ``params`` in the kernels' ``params``.
 EXTRA_FLAGS = PARAMS_SIZE
 
@@ -97,12 +103,19 @@ def joint_rows(ints, dofs, liR, lip, i, W, Y, t1):
 
 
 @inline
-def extra_rows(params, v, a, col, Y):
+def extra_rows(ints, params, q, v, a, col, Y):
     """The extra column blocks from column ``col`` on (flags ``params[EXTRA_FLAGS:]``, see
-    ``EXTRA_COLUMNS``): ``v_k``, ``sgn v_k`` (smoothed when ``params[SMOOTHING] > 0``), ``a_k``, ``1``."""
+    ``EXTRA_COLUMNS``): ``v_k``, ``sgn v_k`` (smoothed when ``params[SMOOTHING] > 0``), ``q_k``
+    (joints of one dof; 0 on the others), ``a_k``, ``1``."""
     nv, eps = v.shape[0], params[SMOOTHING]
-    for block in range(4):
+    for block in range(5):
         if params[EXTRA_FLAGS + block] == 0.0:
+            continue
+        if block == 2:  # the joint coordinate of each one-dof joint: ints[i, IQ]
+            for i in range(ints.shape[0]):
+                if ints[i, NDOF] == 1:
+                    Y[ints[i, IV], col + ints[i, IV]] = q[ints[i, IQ]]
+            col += nv
             continue
         for k in range(nv):
             if block == 0:
@@ -110,7 +123,7 @@ def extra_rows(params, v, a, col, Y):
             elif block == 1:
                 Y[k, col + k] = (np.tanh(v[k] / eps) if eps > 0.0 else
                                  (1.0 if v[k] > 0.0 else (-1.0 if v[k] < 0.0 else 0.0)))
-            elif block == 2:
+            elif block == 3:
                 Y[k, col + k] = a[k]
             else:
                 Y[k, col + k] = 1.0
@@ -134,7 +147,7 @@ def regressor_one(ints, body, dofs, params, q, v, a, check, Y, ws):
     for i in range(nb):
         body_regressor(E, vel[i], acc[i], W, t1, t2)
         joint_rows(ints, dofs, liR, lip, i, W, Y, t1)
-    extra_rows(params, v, a, 10 * nb, Y)
+    extra_rows(ints, params, q, v, a, 10 * nb, Y)
     return result_status(check, finite2(Y))
 
 
@@ -231,7 +244,7 @@ def slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y,
     for i in range(nb):
         body_reference_regressor(E, vel[i], vel_r[i], acc_r[i], W, w, t1, t2)
         joint_rows(ints, dofs, liR, lip, i, W, Y, t1)
-    extra_rows(params, v, a_r, 10 * nb, Y)
+    extra_rows(ints, params, q, v, a_r, 10 * nb, Y)
     return result_status(check, finite2(Y))
 
 
@@ -293,35 +306,49 @@ def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
 
 
 @renamed_keywords(viscous="damping")
-def extra_columns(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
-                  offset: bool = False) -> list[str]:
+def extra_columns(model, *, damping: bool = False, coulomb: bool = False, stiffness: bool = False,
+                  armature: bool = False, offset: bool = False) -> list[str]:
     """Names of the extra regressor columns, in order: ``"damping[joint]"``, ... one per dof."""
     names = model.dof_names
-    flags = dict(damping=damping, coulomb=coulomb, armature=armature, offset=offset)
+    flags = dict(damping=damping, coulomb=coulomb, stiffness=stiffness, armature=armature, offset=offset)
     return [f"{kind}[{n}]" for kind in EXTRA_COLUMNS if flags[kind] for n in names]
 
 
+def spring_offset(model) -> np.ndarray:
+    """``-stiffness * spring_reference`` (nv,): the constant part of the joint springs'
+    torque ``K (q - q_ref)``, the value of the offset columns when the stiffness columns
+    carry ``K``."""
+    return -np.asarray(model.stiffness, dtype=float) * np.asarray(model.spring_reference, dtype=float)
+
+
 @renamed_keywords(viscous="damping")
-def extended_parameters(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
-                        offset=None) -> np.ndarray:
+def extended_parameters(model, *, damping: bool = False, coulomb: bool = False, stiffness: bool = False,
+                        armature: bool = False, offset=None) -> np.ndarray:
     """The parameter vector that matches :func:`regressor` with the same switches:
-    ``[theta, damping, coulomb, armature, offset]`` (blocks present when switched on;
-    ``offset`` is an (nv,) array of joint torque offsets, or None for no offset columns)."""
+    ``[theta, damping, coulomb, stiffness, armature, offset]`` (blocks present when switched
+    on). ``offset``: None for no offset columns, ``True`` for the model's own constant joint
+    torques ``-stiffness * spring_reference`` (:func:`spring_offset`: zero without springs),
+    or an (nv,) array of joint torque offsets. With every block on and ``offset=True``,
+    ``regressor(model, q, v, a, damping=True, coulomb=True, stiffness=True, armature=True,
+    offset=True) @ extended_parameters(...) == rnea(model, q, v, a)``."""
     parts = [model.inertial_parameters()]
-    for on, values in ((damping, model.damping), (coulomb, model.coulomb), (armature, model.armature)):
+    for on, values in ((damping, model.damping), (coulomb, model.coulomb), (stiffness, model.stiffness),
+                       (armature, model.armature)):
         if on:
             parts.append(np.asarray(values, dtype=float))
-    if offset is not None:
+    if offset is True:
+        parts.append(spring_offset(model))
+    elif offset is not None and offset is not False:
         off = np.asarray(offset, dtype=float)
         if off.shape != (model.nv,):
-            raise ValueError(f"offset: expected shape ({model.nv},), got {off.shape}")
+            raise ValueError(f"offset: expected True, None or shape ({model.nv},), got {off.shape}")
         parts.append(off)
     return np.concatenate(parts)
 
 
 @renamed_keywords(viscous="damping")
-def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
-              offset: bool = False, check_finite: bool = True) -> np.ndarray:
+def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, stiffness: bool = False,
+              armature: bool = False, offset: bool = False, check_finite: bool = True) -> np.ndarray:
     """Joint-torque regressor ``Y`` with ``Y @ model.inertial_parameters() == rnea(model, q, v,
     a, friction=False, armature=False)``.
 
@@ -330,10 +357,13 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, a
 
     Args:
         q: (..., nq) configuration. v, a: (..., nv) velocity and acceleration.
-        damping, coulomb, armature, offset: append ``nv`` columns each, in this order, for
-            viscous friction (``v_k``), Coulomb friction (``sgn v_k``, smoothed as in ``rnea``
-            when ``model.coulomb_smoothing > 0``), armature (``a_k``) and a constant joint
-            torque offset (``1``); see :func:`extended_parameters` and :func:`extra_columns`.
+        damping, coulomb, stiffness, armature, offset: append ``nv`` columns each, in this
+            order, for viscous friction (``v_k``), Coulomb friction (``sgn v_k``, smoothed as
+            in ``rnea`` when ``model.coulomb_smoothing > 0``), the joint springs' stiffness
+            (``q_k``, the coordinate of a joint of one dof; 0 on the dofs of free, spherical
+            and planar joints, which have no spring), armature (``a_k``) and a constant joint
+            torque offset (``1``, which also carries the springs' ``-K q_ref``); see
+            :func:`extended_parameters` and :func:`extra_columns`.
         check_finite: reject NaN/Inf inputs.
 
     Returns:
@@ -346,7 +376,7 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, a
         return deferred(regressor, locals())
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     k = model.kernel
-    flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
+    flags = [float(bool(f)) for f in (damping, coulomb, stiffness, armature, offset)]
     params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
@@ -364,7 +394,8 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, a
 
 @renamed_keywords(viscous="damping")
 def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, coulomb: bool = False,
-                         armature: bool = False, offset: bool = False, check_finite: bool = True) -> np.ndarray:
+                         stiffness: bool = False, armature: bool = False, offset: bool = False,
+                         check_finite: bool = True) -> np.ndarray:
     """Slotine-Li regressor ``Y(q, qd, qd_r, qdd_r)``, linear in the inertial parameters::
 
         Y @ model.inertial_parameters() == M(q) qdd_r + C(q, qd) qd_r + g(q)
@@ -386,10 +417,11 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
     Args:
         q: (..., nq) configuration. v: (..., nv) velocity ``qd``. v_ref, a_ref: (..., nv)
             reference velocity ``qd_r`` and acceleration ``qdd_r``.
-        damping, coulomb, armature, offset: extra ``nv``-column blocks as in :func:`regressor`,
-            evaluated at ``(v, a_ref)``: ``v_k``, ``sgn v_k``, ``qdd_r,k``, ``1``; with them,
-            ``Y @ extended_parameters(model, ...) == rnea(q, v, a_ref) - C(q, v) (v - v_ref)``
-            (+ offset): the friction of the true velocity and the armature at ``qdd_r``.
+        damping, coulomb, stiffness, armature, offset: extra ``nv``-column blocks as in
+            :func:`regressor`, evaluated at ``(q, v, a_ref)``: ``v_k``, ``sgn v_k``, ``q_k``,
+            ``qdd_r,k``, ``1``; with them, ``Y @ extended_parameters(model, ...) == rnea(q, v,
+            a_ref) - C(q, v) (v - v_ref)`` (with ``offset=True``): the friction of the true
+            velocity, the springs at ``q`` and the armature at ``qdd_r``.
         check_finite: reject NaN/Inf inputs.
 
     Returns:
@@ -404,7 +436,7 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
         return deferred(slotine_li_regressor, locals())
     batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
     k = model.kernel
-    flags = [float(bool(f)) for f in (damping, coulomb, armature, offset)]
+    flags = [float(bool(f)) for f in (damping, coulomb, stiffness, armature, offset)]
     params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     args = (k.ints, k.body, k.dofs[(False, False)], params)

@@ -2,6 +2,7 @@
 
     robodyn excite MODEL --duration 10 --out traj.csv      optimised excitation: CSV + PNG plot
     robodyn identify MODEL data.csv [--method ols|wls|physical] --out identified.urdf --report DIR
+                                    [--no-friction] [--stiffness] [--offset]
 
 The data CSV layout is described in :mod:`robodyn.identification.data`.
 """
@@ -25,7 +26,8 @@ def cmd_excite(args) -> int:
 
     check_output_file(args.out, "--out")
     model = _model(args)
-    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction)
+    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction,
+                           stiffness=args.stiffness)
     period = args.period if args.period is not None else args.duration
     lim = limits_of(model, acceleration=args.acceleration)
     print(f"{model.name}: {base.count} base parameters; optimising {args.harmonics} harmonics over "
@@ -50,7 +52,8 @@ def cmd_identify(args) -> int:
     check_output_dir(args.report, "--report")
     model = _model(args)
     log = preprocess(read_log(args.data, model, require_tau=True), cutoff=args.cutoff, decimate=args.decimate)
-    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction, offset=args.offset)
+    base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction,
+                           stiffness=args.stiffness, offset=args.offset)
     result = identify(model, log, method=args.method, base=base)
     print(result.summary())
     if args.out:
@@ -76,6 +79,7 @@ def add_commands(sub) -> None:
     p.add_argument("--maxiter", type=int, default=100, help="SLSQP iterations")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--no-friction", action="store_true", help="no viscous/Coulomb friction columns")
+    p.add_argument("--stiffness", action="store_true", help="joint spring stiffness columns too")
     p.set_defaults(func=cmd_excite)
     p = sub.add_parser("identify", help="identify inertial parameters and friction from a CSV log")
     add_model_arguments(p)
@@ -87,5 +91,8 @@ def add_commands(sub) -> None:
     p.add_argument("--cutoff", type=float, default=None, help="zero-phase low-pass cutoff (Hz); default none")
     p.add_argument("--decimate", type=int, default=1, help="keep every N-th sample after filtering")
     p.add_argument("--no-friction", action="store_true", help="do not identify viscous/Coulomb friction")
-    p.add_argument("--offset", action="store_true", help="identify constant joint torque offsets too")
+    p.add_argument("--offset", action="store_true", help="identify constant joint torque offsets too "
+                                                          "(with --stiffness: the springs' reference positions)")
+    p.add_argument("--stiffness", action="store_true",
+                   help="identify joint spring stiffness too (URDF has no springs: --out drops them, with a warning)")
     p.set_defaults(func=cmd_identify)

@@ -1,4 +1,4 @@
-"""Identification of inertial parameters and joint friction.
+"""Identification of inertial parameters, joint friction and joint springs.
 
     import robodyn as rd
     from robodyn import identification as ident
@@ -9,6 +9,7 @@
     exc.trajectory.to_csv("traj.csv", model, duration=20, rate=200)
     log = ident.preprocess(ident.read_log("data.csv", model), cutoff=10)  # filter, differentiate
     result = ident.identify(model, log, method="physical", base=base)
+    sprung = ident.identify(model, log, stiffness=True, offset=True)      # springs: K, and q_ref from -K q_ref
     rd.write_urdf(result.identified_model(), "identified.urdf")
     ident.write_report(result, log, "report/")
     fleet = ident.identify(model, ["robot1.csv", "robot2.parquet"], preprocess={"cutoff": 10}, base=base,

@@ -69,7 +69,7 @@ class BaseParameters:
     coefficients); ``K`` (r, p) with ``theta_base = K theta``; ``names`` (r,): readable
     combinations; ``singular_values`` of the column-scaled stacked regressor; ``gap``:
     ``sigma_r / sigma_{r+1}`` (inf when the regressor has full column rank);
-    ``extra``: the switches of the extra (friction, armature, offset) columns.
+    ``extra``: the switches of the extra (friction, stiffness, armature, offset) columns.
     """
 
     columns: tuple
@@ -138,14 +138,17 @@ def _independent_in_order(Ws, candidates, rtol: float) -> list:
 
 
 @renamed_keywords(viscous="damping")
-def base_parameters(model, *, damping: bool = False, coulomb: bool = False, armature: bool = False,
-                    offset: bool = False, n_states: int | None = None, rtol: float = 1e-8,
+def base_parameters(model, *, damping: bool = False, coulomb: bool = False, stiffness: bool = False,
+                    armature: bool = False, offset: bool = False, n_states: int | None = None, rtol: float = 1e-8,
                     seed: int = 0) -> BaseParameters:
     """Base parameters of ``model`` from the regressor of ``n_states`` random states.
 
     Args:
-        damping, coulomb, armature, offset: include these extra columns (see
+        damping, coulomb, stiffness, armature, offset: include these extra columns (see
             :func:`robodyn.regressor`); they are identifiable with the inertial parameters.
+            The springs' reference positions enter through the offsets (``-K q_ref``): identify
+            them with ``stiffness=True, offset=True``. The stiffness columns of the dofs of free,
+            spherical and planar joints are zero (no springs there) and drop out.
         n_states: number of random states (default: enough for 4 rows per column).
         rtol: relative tolerance on the singular values and on the distance of a column to
             the span of the ones kept.
@@ -155,7 +158,8 @@ def base_parameters(model, *, damping: bool = False, coulomb: bool = False, arma
         ValueError: when the rank from the singular values and the number of columns kept
             disagree (``rtol`` sits inside a cluster of singular values: no clear gap).
     """
-    extra = dict(damping=bool(damping), coulomb=bool(coulomb), armature=bool(armature), offset=bool(offset))
+    extra = dict(damping=bool(damping), coulomb=bool(coulomb), stiffness=bool(stiffness), armature=bool(armature),
+                 offset=bool(offset))
     columns = tuple(parameter_names(model, **extra))
     p = len(columns)
     if model.nv == 0:

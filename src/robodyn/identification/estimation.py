@@ -14,11 +14,12 @@ equations for ``r`` parameters):
   written as ``J = U U^T``, ``U`` upper triangular with exponentiated diagonal (the
   log-Cholesky parameterisation of Rucker and Wensing, "Smooth parameterization of rigid-body
   inertia", IEEE RA-L 7(2), 2022), so that ``m > 0`` and ``J`` is positive definite for every
-  ``x``; friction coefficients are bounded below by 0. ``scipy.optimize.least_squares``
-  solves ``min |W K theta(x) - y|^2 + w |P (theta(x) - theta_prior)|^2``, through the
-  triangular factor of ``[W y]`` (``r`` rows whatever the number of samples); ``P = 1 - K^+ K``
-  projects on the unobservable directions, so the prior (the nominal model) only fixes what
-  the torques cannot tell and does not bias the base parameters.
+  ``x``; friction, stiffness and armature coefficients are bounded below by 0.
+  ``scipy.optimize.least_squares`` solves ``min |W K theta(x) - y|^2 + w |P (theta(x) -
+  theta_prior)|^2``, through the triangular factor of ``[W y]`` (``r`` rows whatever the
+  number of samples); ``P = 1 - K^+ K`` projects on the unobservable directions, so the
+  prior (the nominal model) only fixes what the torques cannot tell and does not bias the
+  base parameters.
 
 All three work on the reduced statistics of the samples (:class:`.reduced.Reduced`: the
 triangular factor ``R_j`` of ``[W_j y_j]`` per joint, of any number of logs combined), never on
@@ -206,7 +207,8 @@ def physical(model, base: BaseParameters, stats: Reduced, prior, *, prior_weight
     ``prior`` (p,): standard parameters ``[theta, extra]`` the unobservable directions are
     drawn to (usually the nominal model); ``start``: initial standard parameters (default: the
     least-squares estimate completed towards the prior, each body moved to the nearest
-    consistent one). Friction columns (damping, Coulomb) and armature are bounded below by 0.
+    consistent one). Friction columns (damping, Coulomb), stiffness and armature are bounded
+    below by 0.
     The Jacobian is analytic (block diagonal ``d theta / d x``, :func:`theta_jacobian`);
     ``scipy.optimize.least_squares`` (trust region reflective, for the bounds) evaluates the
     residual at most ``max_nfev`` times.
@@ -241,7 +243,7 @@ def physical(model, base: BaseParameters, stats: Reduced, prior, *, prior_weight
     logs = [10 * i + k for i in range(nb) for k in range(4)]
     lower[logs], upper[logs] = -LOG_BOUND, LOG_BOUND
     nonneg = [10 * nb + k for k, name in enumerate(base.columns[10 * nb:])
-              if name.split("[")[0] in ("damping", "coulomb", "armature")]
+              if name.split("[")[0] in ("damping", "coulomb", "stiffness", "armature")]
     lower[nonneg] = 0.0
     x0 = np.clip(x0, lower + 1e-9, upper - 1e-9)
 

@@ -2,6 +2,7 @@
 
     base = base_parameters(model, damping=True, coulomb=True)
     result = identify(model, preprocess(read_log("data.csv", model), cutoff=10), method="wls")
+    result = identify(model, log, stiffness=True, offset=True)     # joint springs: K and q_ref
     result = identify(model, ["a.csv", "b.csv"], preprocess={"cutoff": 10}, client=client)  # many logs
     result.predict(other_log)          # torques of another motion
     result.identified_model()          # a Model with the estimated parameters
@@ -19,8 +20,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._deprecated import renamed_keywords
-from ..algorithms.regressor import extended_parameters
+from ..algorithms.regressor import EXTRA_COLUMNS, extended_parameters
 from ..errors import ModelError, RobodynWarning
+from ..joints import NV
 from ._blas import one_blas_thread
 from .base import BaseParameters, base_parameters
 from .data import Log
@@ -35,7 +37,8 @@ METHODS = ("ols", "wls", "physical")
 class Identification:
     """Result of :func:`identify`: the nominal ``model``, its ``base`` parameters, the
     ``estimate``, the ``condition_number`` of the stacked base regressor, the nominal
-    base parameters ``beta_nominal`` (K times the model's own parameters, offsets 0), the
+    base parameters ``beta_nominal`` (K times the model's own parameters, offsets
+    ``-stiffness * spring_reference``: 0 without springs), the
     number of ``samples`` (of all logs) and the ``singular_values`` (r,) of the stacked base
     regressor, largest first."""
 
@@ -65,32 +68,47 @@ class Identification:
         return nominal_parameters(self.model, self.base)
 
     def extra(self) -> dict:
-        """Identified per-dof extra parameters by kind (``damping``, ``coulomb``, ...)."""
+        """Identified per-dof extra parameters by kind (``damping``, ``coulomb``,
+        ``stiffness``, ``armature``, ``offset``), in the column order of the regressor."""
         theta = self.standard_parameters()
         out, col, nv = {}, 10 * self.model.nbodies, self.model.nv
-        for kind in ("damping", "coulomb", "armature", "offset"):
-            if self.base.extra[kind]:
+        for kind in EXTRA_COLUMNS:
+            if self.base.extra.get(kind, False):
                 out[kind] = theta[col:col + nv]
                 col += nv
         return out
 
     def identified_model(self):
-        """The model with the identified inertial parameters, viscous and Coulomb friction and
-        armature (offsets have no place in a model: see :meth:`extra`).
+        """The model with the identified inertial parameters, viscous and Coulomb friction,
+        joint springs and armature (offsets have no place in a model: see :meth:`extra`).
+
+        With ``stiffness`` identified, the springs' reference positions come from the offsets:
+        the offset of a joint with a spring (``K > 0``) is read as the spring's ``-K q_ref``,
+        ``spring_reference = -offset / K`` (so the model's torques are those of the
+        estimate); without offset columns the reference is 0 (the estimate's ``K q``). The
+        offsets of joints without a spring are dropped.
 
         Least-squares estimates that are not physically consistent give a model built with
-        ``physical="warn"`` (and a :class:`RobodynWarning`); negative friction is set to 0
-        with a warning. A negative mass raises :class:`ModelError`: use ``method="physical"``.
+        ``physical="warn"`` (and a :class:`RobodynWarning`); negative friction, stiffness or
+        armature is set to 0 with a warning. A negative mass raises :class:`ModelError`: use
+        ``method="physical"``.
         """
         theta = self.standard_parameters()
         nb = self.model.nbodies
         changes = {"theta": theta[:10 * nb].reshape(nb, 10)}
-        for kind, values in self.extra().items():
-            if kind in ("damping", "coulomb", "armature"):  # model fields of the same names
+        extra = self.extra()
+        for kind, values in extra.items():
+            if kind in ("damping", "coulomb", "stiffness", "armature"):  # model fields of the same names
+                if kind == "stiffness":  # springs sit on joints of one dof: the other columns are 0
+                    values = np.where(self._one_dof(), values, 0.0)
                 if np.any(values < 0):
-                    warnings.warn(f"identified {kind} friction/armature negative at dofs "
+                    warnings.warn(f"identified {kind} negative at dofs "
                                   f"{np.flatnonzero(values < 0).tolist()}: set to 0", RobodynWarning, stacklevel=2)
                 changes[kind] = np.maximum(values, 0.0)
+        if "stiffness" in changes:
+            K, offset = changes["stiffness"], extra.get("offset", np.zeros(self.model.nv))
+            sprung = K > 0
+            changes["spring_reference"] = np.where(sprung, -offset / np.where(sprung, K, 1.0), 0.0)
         try:
             return self.model.replace(**changes, physical="error")
         except ModelError as e:
@@ -113,17 +131,28 @@ class Identification:
                          f"{self.beta_nominal[k]:13.6g}  {name}")
         return "\n".join(lines)
 
+    def _one_dof(self) -> np.ndarray:
+        """(nv,) whether each dof belongs to a joint of one dof (the joints that take springs)."""
+        m = self.model
+        one = np.zeros(m.nv, dtype=bool)
+        for i in range(m.nbodies):
+            if NV[m.joint_type[i]] == 1:
+                one[m.idx_v[i]] = True
+        return one
+
 
 def nominal_parameters(model, base: BaseParameters) -> np.ndarray:
-    """The model's own ``[theta, extra]`` in the column order of ``base`` (offsets 0)."""
-    e = base.extra
-    return extended_parameters(model, damping=e["damping"], coulomb=e["coulomb"], armature=e["armature"],
-                               offset=np.zeros(model.nv) if e["offset"] else None)
+    """The model's own ``[theta, extra]`` in the column order of ``base`` (offsets
+    ``-stiffness * spring_reference``, the springs' constant torque: 0 without springs)."""
+    e = {kind: base.extra.get(kind, False) for kind in EXTRA_COLUMNS}
+    return extended_parameters(model, damping=e["damping"], coulomb=e["coulomb"], stiffness=e["stiffness"],
+                               armature=e["armature"], offset=True if e["offset"] else None)
 
 
 @renamed_keywords(viscous="damping")
 def identify(model, log, *, method: str = "ols", damping: bool = True, coulomb: bool = True,
-             armature: bool = False, offset: bool = False, base: BaseParameters | None = None,
+             stiffness: bool = False, armature: bool = False, offset: bool = False,
+             base: BaseParameters | None = None,
              prior_weight: float = 1e-8, preprocess: dict | None = None, client=None,
              block: int = BLOCK) -> Identification:
     """Identify the base parameters of ``model`` from one log or many.
@@ -134,8 +163,11 @@ def identify(model, log, *, method: str = "ols", damping: bool = True, coulomb: 
             (pandas DataFrames too), or a Dask DataFrame with one log per partition
             (:mod:`.fleet`); or :class:`.reduced.Reduced` statistics of ``base``'s regressor.
         method: ``"ols"``, ``"wls"`` or ``"physical"`` (see :mod:`.estimation`).
-        damping, coulomb, armature, offset: the extra columns identified with the inertial
-            parameters (ignored when ``base`` is given: its own switches apply).
+        damping, coulomb, stiffness, armature, offset: the extra columns identified with the
+            inertial parameters (ignored when ``base`` is given: its own switches apply). The
+            joint springs: ``stiffness=True, offset=True`` identifies their stiffness ``K`` and,
+            through the offsets ``-K q_ref``, their reference positions
+            (:meth:`Identification.identified_model`).
         base: precomputed base parameters (default :func:`base_parameters` of the model).
         prior_weight: weight of the nominal parameters in ``physical``.
         preprocess: None (every log used as it is: it needs ``v`` and ``a``), or the keywords
@@ -153,7 +185,8 @@ def identify(model, log, *, method: str = "ols", damping: bool = True, coulomb: 
     if method not in METHODS:
         raise ValueError(f"method: expected one of {METHODS}, got {method!r}")
     if base is None:
-        base = base_parameters(model, damping=damping, coulomb=coulomb, armature=armature, offset=offset)
+        base = base_parameters(model, damping=damping, coulomb=coulomb, stiffness=stiffness, armature=armature,
+                               offset=offset)
     r = base.count
     with one_blas_thread():
         stats = reduce_logs(model, base, log, preprocess=preprocess, client=client, block=block)

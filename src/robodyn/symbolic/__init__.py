@@ -3,6 +3,7 @@
     import robodyn as rd
     eom = rd.symbolic.equations_of_motion(rd.models.load("planar_2r"))
     eom.M, eom.C, eom.g, eom.T, eom.U, eom.L, eom.tau     # sympy, in q, v, a
+    eom.tau_p                                             # friction and springs: tau = M a + C v + g + tau_p
     M = eom.to_function("M")                              # NumPy, batched: M(q) (..., n, n)
     M = rd.symbolic.recursive_dynamics(model).to_numba("M")   # fast M without deriving
     eom.to_c("out/")                                      # C source and header
@@ -12,8 +13,8 @@ Symbolic models (:class:`SymbolicModel`) come from a numeric model (:func:`from_
 DH table with symbols (:func:`from_dh`), joint twists (:func:`from_poe`), links and joints
 (:class:`ModelBuilder`), or either with named
 inertial parameters (:func:`with_inertia_symbols`); :mod:`.textbook` has the textbooks'
-robots (``textbook.scara_mls()``, ``elbow_mls()``, ``planar_2r_mls()``); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``
-and ``tau`` from the recursions without the expanded derivation; :func:`regressor` gives
+robots (``textbook.scara_mls()``, ``elbow_mls()``, ``planar_2r_mls()``); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``,
+``tau`` and ``tau_p`` from the recursions without the expanded derivation; :func:`regressor` gives
 ``Y(q, v, a)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
 """
 

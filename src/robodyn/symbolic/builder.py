@@ -17,6 +17,10 @@ joints were added, and fixed joints merge their child link into the parent body 
 inertial parameters moved by the exact parallel-axis rule). Joints: ``revolute`` (or
 ``continuous``), ``prismatic`` and ``fixed``; the base is fixed. A joint's frame is at ``xyz``
 with rotation ``rotation`` (3 x 3) in the parent link's frame; ``axis`` is a unit vector in it.
+A moving joint takes its passive elements as keywords, numbers or expressions:
+``armature``, ``damping``, ``coulomb``, ``stiffness`` and ``spring_reference`` (the fields of
+:class:`.model.SymbolicModel`; checked as the numeric builder checks them), and the builder
+the model's ``coulomb_smoothing``.
 """
 
 from __future__ import annotations
@@ -25,7 +29,8 @@ import sympy as sp
 
 from ..builder import WORLD, JointEntry, LinkEntry, ModelBuilder as NumericBuilder
 from ..model import ModelError
-from .model import SymbolicModel, exact, inertial_parameters, exact_matrix3, skew, exact_vector
+from .model import (PASSIVE_FIELDS, SymbolicModel, exact_matrix3, exact_vector, inertial_parameters,
+                    passive_value, skew)
 
 KINDS = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
 
@@ -47,9 +52,11 @@ class ModelBuilder(NumericBuilder):
     """Collects links and joints with sympy entries; :meth:`build` returns a
     :class:`SymbolicModel` (module docstring)."""
 
-    def __init__(self, name: str = "robot", gravity=(0, 0, -sp.Rational(981, 100)), source: str = "<symbolic model>"):
+    def __init__(self, name: str = "robot", gravity=(0, 0, -sp.Rational(981, 100)), source: str = "<symbolic model>",
+                 *, coulomb_smoothing=0):
         super().__init__(name, source=source)
         self.symbolic_gravity = exact_vector(gravity, 3, "gravity")
+        self.coulomb_smoothing = passive_value(coulomb_smoothing, "coulomb_smoothing", True)
 
     def add_link(self, name: str, mass=0, com=(0, 0, 0), inertia=None, where: str | None = None) -> None:
         """A rigid body: ``mass``, ``com`` (3,) in the link frame, ``inertia`` (3 x 3) about
@@ -63,9 +70,13 @@ class ModelBuilder(NumericBuilder):
         self._links[name] = LinkEntry(name, inertial_parameters(mass, com, Ic), where)
 
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0, 0, 0), rotation=None,
-                  axis=(1, 0, 0), armature=0, where: str | None = None) -> None:
+                  axis=(1, 0, 0), armature=0, where: str | None = None, *, damping=0, coulomb=0, stiffness=0,
+                  spring_reference=0) -> None:
         """A joint from ``parent`` to ``child`` at ``xyz`` / ``rotation`` in the parent link's
-        frame, moving about or along the unit ``axis`` (module docstring)."""
+        frame, moving about or along the unit ``axis`` (module docstring), with rotor inertia
+        ``armature``, viscous ``damping``, ``coulomb`` friction and a spring
+        ``stiffness (q - spring_reference)`` (the passive forces of
+        :func:`.model.passive_torque`; a fixed joint has none)."""
         where = where or f"{self.source}: joint {name!r}"
         if type not in KINDS:
             raise ModelError(f"{where}: joint type {type!r}: a symbolic model has {sorted(KINDS)} joints")
@@ -73,13 +84,20 @@ class ModelBuilder(NumericBuilder):
         ax = exact_vector(axis, 3, f"{where}: axis")
         if type != "fixed" and not (ax.free_symbols or sp.simplify(ax.dot(ax) - 1) == 0):
             raise ModelError(f"{where}: axis must be a unit vector, got {list(ax)}")
+        passive = dict(damping=damping, coulomb=coulomb, stiffness=stiffness, spring_reference=spring_reference)
+        limits = dict(armature=passive_value(armature, f"{where}: armature", True))
+        for what, nonnegative in PASSIVE_FIELDS:
+            limits[what] = passive_value(passive[what], f"{where}: {what}", nonnegative)
+        if type == "fixed" and any(x != 0 for x in limits.values()):
+            raise ModelError(f"{where}: a fixed joint has no armature, friction or spring")
         self._joints.append(JointEntry(name, KINDS[type], parent, child, R, exact_vector(xyz, 3, f"{where}: xyz"), ax,
-                                   dict(armature=exact(armature)), where))
+                                   limits, where))
 
     def build(self) -> SymbolicModel:
         """The :class:`SymbolicModel` (fixed base)."""
         root, children = self._check_graph()
-        parent, types, axes, XR, Xp, theta, arm, links, joints = [], [], [], [], [], [], [], [], []
+        parent, types, axes, XR, Xp, theta, links, joints = [], [], [], [], [], [], [], []
+        passive = {what: [] for what in ("armature", *(f for f, _ in PASSIVE_FIELDS))}
         place = {root: (-1, sp.eye(3), sp.zeros(3, 1))}   # link -> (body, R, p) of its frame in the body
         stack = list(reversed(children[root]))            # depth first, children in the order added
         while stack:
@@ -95,7 +113,8 @@ class ModelBuilder(NumericBuilder):
                 XR.append(Rj)
                 Xp.append(pj)
                 theta.append([0] * 10)
-                arm.append(jt.limits["armature"])
+                for what, values in passive.items():
+                    values.append(jt.limits[what])
                 links.append(jt.child)
                 joints.append(jt.name)
                 place[jt.child] = (len(parent) - 1, sp.eye(3), sp.zeros(3, 1))
@@ -108,8 +127,9 @@ class ModelBuilder(NumericBuilder):
             raise ModelError(f"{self.source}: no moving joint")
         return SymbolicModel(parent=tuple(parent), joint_type=tuple(types), joint_axis=tuple(axes),
                              X_tree_R=tuple(XR), X_tree_p=tuple(Xp), theta=tuple(theta),
-                             gravity=self.symbolic_gravity, armature=tuple(arm), name=self.name,
-                             link_names=tuple(links), joint_names=tuple(joints))
+                             gravity=self.symbolic_gravity, name=self.name, link_names=tuple(links),
+                             joint_names=tuple(joints), coulomb_smoothing=self.coulomb_smoothing,
+                             **{what: tuple(values) for what, values in passive.items()})
 
 
 __all__ = ["ModelBuilder", "WORLD"]

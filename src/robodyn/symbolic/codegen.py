@@ -145,15 +145,27 @@ def monomial_cse(polys, values):
 
 
 def program(name: str, exprs, shape: tuple, args: list, trig: list, doc: str = "", polys=None,
-            values=None) -> Program:
+            values=None, extra=None) -> Program:
     """Common-subexpression elimination of ``exprs`` (flat list) into a :class:`Program`;
     for big inputs given also as ring ``polys`` with generator ``values``, the monomial
-    table of :func:`monomial_cse`."""
+    table of :func:`monomial_cse`. ``extra`` (flat list of sympy expressions in the inputs,
+    or None): terms added to the outputs that are not ring polynomials (the joints' passive
+    forces and spring energy, with ``q_k`` itself and ``sign``); ``exprs`` leaves them out."""
+    extra = [sp.sympify(e) for e in extra] if extra is not None else None
     if polys is not None and sum(len(p) for p in polys) > CSE_TERMS:
         assignments, outputs, used = monomial_cse(polys, values)
         used = set().union(*(v.free_symbols for v in used))
+        if extra is not None:  # the ring part named, then the extra term added to it
+            names = sp.numbered_symbols("z", real=True)
+            for k, e in enumerate(extra):
+                if e != 0:
+                    z = next(names)
+                    assignments.append((z, outputs[k]))
+                    outputs[k] = z + _floats(e)
         return Program(name, tuple(shape), args, _used_trig(trig, used), assignments, outputs, doc)
     exprs = [sp.sympify(e) for e in exprs]
+    if extra is not None:
+        exprs = [e + x for e, x in zip(exprs, extra)]
     if exprs and any(not e.is_number for e in exprs):
         assignments, outputs = sp.cse(exprs, symbols=sp.numbered_symbols("x", real=True), order="none")
     else:

@@ -1,4 +1,4 @@
-"""Closed-form equations of motion ``M(q) a + C(q, v) v + g(q) = tau``.
+"""Closed-form equations of motion ``M(q) a + C(q, v) v + g(q) + tau_p(q, v) = tau``.
 
 :func:`equations_of_motion` derives them by the energy route (:mod:`.lagrange`) or the
 recursive Newton-Euler route (:mod:`.newton_euler`) in exact trigonometric polynomials
@@ -11,18 +11,31 @@ accelerations, named as everywhere in robodyn; their symbols print as q-dot, q-d
                  Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2, so Mdot - 2C is
                  skew-symmetric (as robodyn.coriolis_matrix)
     C_v  (n,)    C v, the Coriolis and centrifugal forces
-    g    (n,)    gravity forces dU/dq (as robodyn.gravity)
-    T, U, L      kinetic energy v^T M v / 2, potential energy -sum m_i g . p_ci, T - U
-    tau  (n,)    M a + C v + g (as robodyn.rnea without friction)
+    g    (n,)    gravity forces (as robodyn.gravity), the derivative of the gravity part of U
+    tau_p (n,)   passive joint forces b v + Fc sgn(v) + K (q - q_ref): the joints' viscous
+                 damping b, Coulomb friction Fc (sgn = sympy's sign, or tanh(v / eps) when
+                 the model's coulomb_smoothing eps > 0, as robodyn.rnea) and springs of
+                 stiffness K about spring_reference q_ref
+    T, U, L      kinetic energy v^T M v / 2, potential energy -sum m_i g . p_ci
+                 + sum K (q - q_ref)^2 / 2 (gravity and the springs, as a simulated
+                 trajectory's potential), T - U
+    tau  (n,)    M a + C v + g + tau_p (as robodyn.rnea)
 
-Friction is not part of these terms. Expressions of up to ``TRIG_TERMS`` terms are rewritten
-with the angle-sum rules (sympy's ``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay
-otherwise in the canonical expanded form (no ``simplify`` or ``trigsimp`` on big
-expressions, which is what makes other tools take hours). Code generation
-(:meth:`EquationsOfMotion.to_function`, ``to_numba``, ``to_c``) writes ``M``, ``C_v``,
-``g`` and ``tau`` by default as the straight-line code of the recursions (:mod:`.recursive`:
-not expanded, fast to compile and to run) and the other terms, or every term with
-``form="expanded"``, as the expanded expressions after common-subexpression elimination.
+``friction=False`` (as ``robodyn.rnea(..., friction=False)``) leaves the passive elements out:
+``tau_p`` is zero, ``U`` has no spring energy and ``tau = M a + C v + g`` (the armature stays
+in ``M``, as ``rnea``'s ``armature=True``). ``dU/dq = g + K (q - q_ref)``: the springs' force is
+a part of ``tau_p``, not of ``g``. ``tau_p`` and the spring energy are written in ``q_k``
+itself and ``sign(v_k)``, not in the ring's ``sin q_k``, ``cos q_k``; they are kept apart from
+the ring polynomials (:attr:`EquationsOfMotion.polynomials`) and added to them.
+
+Expressions of up to ``TRIG_TERMS`` terms are rewritten with the angle-sum rules (sympy's
+``TR10i``: ``c1 c2 - s1 s2 = cos(q1 + q2)``); all stay otherwise in the canonical expanded
+form (no ``simplify`` or ``trigsimp`` on big expressions, which is what makes other tools
+take hours). Code generation (:meth:`EquationsOfMotion.to_function`, ``to_numba``,
+``to_c``) writes ``M``, ``C_v``, ``g``, ``tau`` and ``tau_p`` by default as the straight-line
+code of the recursions (:mod:`.recursive`: not expanded, fast to compile and to run) and the
+other terms, or every term with ``form="expanded"``, as the expanded expressions after
+common-subexpression elimination.
 """
 
 from __future__ import annotations
@@ -36,8 +49,8 @@ from .._deprecated import renamed_attribute
 from . import codegen, lagrange, newton_euler
 from ._ring import TrigRing, readable_numbers
 from ._terms import GeneratedCode, check_form, check_term, signature
-from .model import SymbolicModel, from_model
-from .recursive import RECURSIONS, recursive_program
+from .model import SymbolicModel, from_model, passive_torque, spring_energy
+from .recursive import RECURSIONS, recursive_program, tau_description
 
 METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
 # Expressions with at most this many terms are rewritten with the angle-sum rules.
@@ -76,13 +89,15 @@ def christoffel_from_quadratic(rg: TrigRing, quad, n: int) -> list:
 
 class EquationsOfMotion(GeneratedCode):
     """The closed-form terms of one model (module docstring); ``method`` says how they
-    were derived. Terms are computed once, on first access."""
+    were derived, ``friction`` whether the passive forces ``tau_p`` (and the springs' energy)
+    are in. Terms are computed once, on first access."""
 
     default_c_terms = ("M", "C", "g", "tau")
 
-    def __init__(self, model: SymbolicModel, method: str, rg: TrigRing, result: dict):
+    def __init__(self, model: SymbolicModel, method: str, rg: TrigRing, result: dict, friction: bool = True):
         self.model = model
         self.method = method
+        self.friction = bool(friction)
         self._rg = rg
         n = model.nv
         self.n = n
@@ -100,6 +115,11 @@ class EquationsOfMotion(GeneratedCode):
             "U": result["U"],
         }
         self._poly["L"] = result["T"] - result["U"]
+        self._poly["tau_p"] = [rg.zero] * n
+        # the terms outside the ring: passive forces and spring energy (symbols q_k, v_k)
+        tau_p = [passive_torque(model, k) if friction else sp.Integer(0) for k in range(n)]
+        U_spring = spring_energy(model) if friction else sp.Integer(0)
+        self._extra = {"tau_p": tau_p, "tau": tau_p, "U": [U_spring], "L": [-U_spring]}
         if method == "newton_euler":
             self._poly["C"] = christoffel_from_quadratic(rg, self._poly["C_v"], n)
         else:
@@ -111,22 +131,36 @@ class EquationsOfMotion(GeneratedCode):
             raise AssertionError(f"tau has terms of degrees {sorted(extra)} in (qd, qdd)")
 
     def __repr__(self) -> str:
-        return f"EquationsOfMotion({self.model.name!r}, method={self.method!r}, n={self.n})"
+        return (f"EquationsOfMotion({self.model.name!r}, method={self.method!r}, n={self.n}"
+                f"{'' if self.friction else ', friction=False'})")
 
     # -- sympy expressions -------------------------------------------------------------
-    def _expr(self, p, trig: str = "functions"):
+    def _expr(self, p, trig: str = "functions", extra=0):
         e = self._rg.expr(p, trig)
         if trig == "functions" and 1 < len(p) <= TRIG_TERMS:
             e = TR10i(e)  # c1 c2 - s1 s2 -> cos(q1 + q2), ...
-        return readable_numbers(e)
+        return readable_numbers(e + extra)
+
+    def flat_terms(self, name: str) -> tuple[list, list]:
+        """``(polynomials, extra)`` of a term, flat and row-major: the ring part of each entry
+        (:attr:`polynomials`) and the sympy expression added to it (the passive forces and
+        the springs' energy: zero for the other terms)."""
+        p = self._poly[name]
+        flat = [x for row in p for x in row] if name in ("M", "C") else (p if isinstance(p, list) else [p])
+        return flat, self._extra.get(name, [sp.Integer(0)] * len(flat))
+
+    def _entry_expressions(self, name: str, trig: str = "functions") -> list:
+        """The entries of a term as sympy expressions, flat and row-major."""
+        flat, extra = self.flat_terms(name)
+        return [self._expr(x, trig, e) for x, e in zip(flat, extra)]
 
     def _shaped(self, name: str, trig: str = "functions"):
-        p = self._poly[name]
+        entries = self._entry_expressions(name, trig)
         if name in ("M", "C"):
-            return sp.Matrix(self.n, self.n, [self._expr(x, trig) for row in p for x in row])
-        if name in ("g", "C_v", "tau"):
-            return sp.Matrix(self.n, 1, [self._expr(x, trig) for x in p])
-        return self._expr(p, trig)
+            return sp.Matrix(self.n, self.n, entries)
+        if name in ("g", "C_v", "tau", "tau_p"):
+            return sp.Matrix(self.n, 1, entries)
+        return entries[0]
 
     @cached_property
     def M(self) -> sp.Matrix:
@@ -153,8 +187,14 @@ class EquationsOfMotion(GeneratedCode):
         return self._shaped("g")
 
     @cached_property
+    def tau_p(self) -> sp.Matrix:
+        """Passive joint forces ``b v + Fc sgn(v) + K (q - q_ref)`` (n x 1): damping, Coulomb
+        friction and springs (zero with ``friction=False``)."""
+        return self._shaped("tau_p")
+
+    @cached_property
     def tau(self) -> sp.Matrix:
-        """Joint forces ``M a + C v + g`` (n x 1)."""
+        """Joint forces ``M a + C v + g + tau_p`` (n x 1), as ``robodyn.rnea``."""
         return self._shaped("tau")
 
     @cached_property
@@ -164,7 +204,8 @@ class EquationsOfMotion(GeneratedCode):
 
     @cached_property
     def U(self) -> sp.Expr:
-        """Potential energy ``-sum_i m_i g . p_ci``."""
+        """Potential energy ``-sum_i m_i g . p_ci + sum_k K_k (q_k - q_ref_k)^2 / 2`` (gravity
+        and the joint springs)."""
         return self._shaped("U")
 
     @cached_property
@@ -179,21 +220,25 @@ class EquationsOfMotion(GeneratedCode):
 
     @property
     def polynomials(self) -> dict:
-        """The terms as polynomials of :attr:`ring`: ``"M"``, ``"C"`` (lists of rows), ``"g"``,
-        ``"tau"`` (lists), ``"T"``, ``"U"`` (one polynomial each)."""
+        """The rigid-body parts of the terms as polynomials of :attr:`ring`: ``"M"``, ``"C"``
+        (lists of rows), ``"g"``, ``"C_v"``, ``"tau"``, ``"tau_p"`` (lists), ``"T"``, ``"U"``,
+        ``"L"`` (one polynomial each). The passive forces and the springs' energy are not
+        ring polynomials (they hold ``q_k`` and ``sign``): :meth:`flat_terms` has them."""
         return self._poly
 
     def term(self, name: str):
-        """A term by name: ``"M"``, ``"C"``, ``"C_v"``, ``"g"``, ``"tau"``, ``"T"``, ``"U"``, ``"L"``."""
+        """A term by name: ``"M"``, ``"C"``, ``"C_v"``, ``"g"``, ``"tau_p"``, ``"tau"``, ``"T"``,
+        ``"U"``, ``"L"``."""
         name = check_term(name)
         return getattr(self, name)
 
     def equals(self, other: "EquationsOfMotion", name: str) -> bool:
         """Exact equality of a term with the same term of ``other`` (same model), by the
-        canonical polynomial form: no simplification heuristics involved."""
-        a, b = self._poly[name], other._poly[name]
-        flat = lambda x: [e for row in x for e in row] if isinstance(x, list) and x and isinstance(x[0], list) else (x if isinstance(x, list) else [x])  # noqa: E731
-        return all(self._rg.expr(u, "symbols") - other._rg.expr(v, "symbols") == 0 for u, v in zip(flat(a), flat(b)))
+        canonical polynomial form (and the passive terms, which are built alike): no
+        simplification heuristics involved."""
+        (a, x), (b, y) = self.flat_terms(name), other.flat_terms(name)
+        return all(self._rg.expr(u, "symbols") - other._rg.expr(v, "symbols") == 0 and sp.expand(e - f) == 0
+                   for u, v, e, f in zip(a, b, x, y))
 
     # -- output ------------------------------------------------------------------------
     def program(self, name: str, form: str = "auto") -> codegen.Program:
@@ -203,8 +248,9 @@ class EquationsOfMotion(GeneratedCode):
         common-subexpression elimination; ``form="recursive"``: ``M`` by the
         composite-rigid-body recursion, ``C_v``, ``g``, ``tau`` by the Newton-Euler recursion
         (:mod:`.recursive`: straight-line code, not expanded, much faster for 6 and more
-        joints); ``form="auto"`` (default): recursive for these four terms, expanded for
-        ``C``, ``T``, ``U``, ``L``. Both forms compute the same functions."""
+        joints), ``tau_p`` written out joint by joint; ``form="auto"`` (default): recursive
+        for these five terms, expanded for ``C``, ``T``, ``U``, ``L``. Both forms compute the
+        same functions; ``tau`` includes ``tau_p`` unless ``friction=False``."""
         check_form(form)
         name = check_term(name)
         if form == "auto":
@@ -212,20 +258,22 @@ class EquationsOfMotion(GeneratedCode):
         if form == "recursive" and name not in RECURSIONS:
             raise ValueError(f"form='recursive' is available for {list(RECURSIONS)}, not {name!r}")
         if (name, form) not in self._programs:
-            self._programs[name, form] = (recursive_program(self.model, name) if form == "recursive"
+            self._programs[name, form] = (recursive_program(self.model, name, self.friction) if form == "recursive"
                                           else self._expanded_program(name))
         return self._programs[name, form]
 
     def _expanded_program(self, name: str) -> codegen.Program:
         rg, n = self._rg, self.n
         p = self._poly[name]
-        flat = [x for row in p for x in row] if name in ("M", "C") else (p if isinstance(p, list) else [p])
+        flat, extra = self.flat_terms(name)
         shape = (n, n) if name in ("M", "C") else ((n,) if isinstance(p, list) else ())
         big = sum(len(x) for x in flat) > codegen.CSE_TERMS
         exprs = None if big else [rg.expr(x, "symbols") for x in flat]
-        args, doc = signature(self.model, name, f"expanded ({self.method.replace('_', '-')} derivation)")
+        how = f"expanded ({self.method.replace('_', '-')} derivation)"
+        args, doc = signature(self.model, name, tau_description(name, how, self.friction))
         trig = [(*rg.trig_names(k), self.q[k]) for k in range(n) if rg.revolute[k]]
-        return codegen.program(name, exprs, shape, args, trig, doc, polys=flat, values=rg.generator_values())
+        return codegen.program(name, exprs, shape, args, trig, doc, polys=flat, values=rg.generator_values(),
+                               extra=extra)
 
     def latex(self, name: str | None = None) -> str:
         """LaTeX of one term (``name``), or with ``name=None`` a complete document with the
@@ -237,16 +285,19 @@ class EquationsOfMotion(GeneratedCode):
         return term_latex(self, name)
 
 
-def equations_of_motion(model, method: str = "lagrange") -> EquationsOfMotion:
+def equations_of_motion(model, method: str = "lagrange", *, friction: bool = True) -> EquationsOfMotion:
     """Closed-form equations of motion of ``model`` (a :class:`robodyn.Model` with revolute
     and prismatic joints on a fixed base, or a :class:`SymbolicModel`).
 
-    ``method="lagrange"``: Euler-Lagrange equations of ``T = qd^T M qd / 2`` and
-    ``U = -sum m_i g . p_ci`` (:mod:`.lagrange`); ``method="newton_euler"``: the recursive
-    Newton-Euler algorithm on symbols (:mod:`.newton_euler`). Both give identical terms.
+    ``method="lagrange"``: Euler-Lagrange equations of ``T = qd^T M qd / 2`` and the gravity
+    potential ``-sum m_i g . p_ci`` (:mod:`.lagrange`); ``method="newton_euler"``: the
+    recursive Newton-Euler algorithm on symbols (:mod:`.newton_euler`). Both give identical
+    terms. ``friction``: add the joints' passive forces ``tau_p`` (damping, Coulomb friction,
+    springs) to ``tau`` and the springs' energy to ``U``, as ``robodyn.rnea``'s switch of the
+    same name (module docstring).
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
     sm = from_model(model)
     rg = TrigRing(sm)
-    return EquationsOfMotion(sm, method, rg, METHODS[method](rg))
+    return EquationsOfMotion(sm, method, rg, METHODS[method](rg), friction)

@@ -2,7 +2,9 @@
 
 Joint symbols print as ``q_1``, ``\\dot{q}_1``, ``\\ddot{q}_1``; ``sin q_1`` and ``cos q_1``
 as ``s_1`` and ``c_1`` (defined at the top of the document), which keeps the formulas
-of a small robot readable.
+of a small robot readable. The passive joint forces ``tau_p`` (friction and springs) print
+with sympy's ``\\operatorname{sign}`` (or ``\\tanh``); the document has their section and
+their term in the equation of motion when the model has some.
 """
 
 from __future__ import annotations
@@ -17,11 +19,13 @@ _DESCRIPTION = {
     "C_v": r"Coriolis and centrifugal forces $C(q, \dot q)\,\dot q$",
     "g": "Gravity forces $g(q)$",
     "T": "Kinetic energy $T$",
-    "U": "Potential energy $U$",
+    "U": "Potential energy $U$ (gravity and joint springs)",
     "L": "Lagrangian $L = T - U$",
-    "tau": r"Joint forces $\tau = M \ddot q + C \dot q + g$",
+    "tau_p": r"Passive joint forces $\tau_p = B \dot q + F_c \operatorname{sgn}(\dot q) + K (q - q_{ref})$",
+    "tau": r"Joint forces $\tau = M \ddot q + C \dot q + g + \tau_p$",
 }
-_LHS = {"M": "M", "C": "C", "C_v": r"(C\dot q)", "g": "g", "tau": r"\tau", "T": "T", "U": "U", "L": "L"}
+_LHS = {"M": "M", "C": "C", "C_v": r"(C\dot q)", "g": "g", "tau_p": r"\tau_{p}", "tau": r"\tau", "T": "T", "U": "U",
+        "L": "L"}
 
 
 def _names(eom) -> dict:
@@ -44,12 +48,17 @@ def _entries(eom, name: str) -> list[tuple[str, sp.Expr]]:
     p = eom.polynomials[name]
     rg = eom.ring
     lhs = _LHS[name]
+    flat, extra = eom.flat_terms(name)
+    e = [rg.expr(x, "symbols") + x_extra for x, x_extra in zip(flat, extra)]
+    n = eom.n
     if name in ("M", "C"):
-        return [(f"{lhs}_{{{i + 1}{j + 1}}}", rg.expr(p[i][j], "symbols"))
-                for i in range(eom.n) for j in range(eom.n) if j >= i or name == "C"]
+        return [(f"{lhs}_{{{i + 1}{j + 1}}}", e[i * n + j])
+                for i in range(n) for j in range(n) if j >= i or name == "C"]
+    if name == "tau_p":
+        return [(rf"\tau_{{p,{i + 1}}}", x) for i, x in enumerate(e)]
     if isinstance(p, list):
-        return [(f"{lhs}_{{{i + 1}}}", rg.expr(x, "symbols")) for i, x in enumerate(p)]
-    return [(lhs, rg.expr(p, "symbols"))]
+        return [(f"{lhs}_{{{i + 1}}}", x) for i, x in enumerate(e)]
+    return [(lhs, e[0])]
 
 
 def term_latex(eom, name: str) -> str:
@@ -62,6 +71,7 @@ def term_latex(eom, name: str) -> str:
 def document(eom) -> str:
     """A complete LaTeX document: the model, the notation and every term."""
     m = eom.model
+    passive = any(x != 0 for x in eom.tau_p)  # the section and the term only when there are some
     joints = ", ".join(f"{n} ({t})" for n, t in zip(m.joint_names, m.joint_type))
     params = ", ".join(f"${sp.latex(s)}$" for s in eom.parameters) or "none (numeric model)"
     notation = ", ".join(f"$s_{{{k + 1}}} = \\sin q_{{{k + 1}}}$, $c_{{{k + 1}}} = \\cos q_{{{k + 1}}}$"
@@ -78,11 +88,12 @@ def document(eom) -> str:
         rf"Derived by \texttt{{robodyn.symbolic}} ({eom.method.replace('_', '-')} method). "
         rf"{eom.n} joints: {joints.replace('_', chr(92) + '_')}. Parameters: {params}.",
         "",
-        r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) = \tau \]",
+        (r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) + \tau_p(q, \dot q) = \tau \]" if passive
+         else r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) = \tau \]"),
         "",
         f"Notation: {notation}." if notation else "",
     ]
-    for name in ("M", "C", "g", "T", "U", "L", "tau"):
+    for name in ("M", "C", "g", *(("tau_p",) if passive else ()), "T", "U", "L", "tau"):
         parts += [rf"\section*{{{_DESCRIPTION[name]}}}", term_latex(eom, name), ""]
     parts.append(r"\end{document}")
     return "\n".join(parts) + "\n"

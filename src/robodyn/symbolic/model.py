@@ -19,6 +19,16 @@ Three ways to get one:
   are sympy expressions or numbers, standard or modified convention;
 * :func:`with_inertia_symbols`: any of them with the inertial parameters replaced by the
   named symbols ``m1, mx1, my1, mz1, Ixx1, Ixy1, Iyy1, Ixz1, Iyz1, Izz1, m2, ...``.
+
+Per joint the model carries, as the numeric one, the passive elements: ``armature`` (on the
+diagonal of ``M``), viscous ``damping`` ``b``, ``coulomb`` friction ``Fc`` and a joint spring of
+``stiffness`` ``K`` about ``spring_reference`` ``q_ref``, with ``coulomb_smoothing`` ``eps``
+(one for the model). They give the passive joint forces of :mod:`.equations`,
+``tau_p = b qd + Fc sgn(qd) + K (q - q_ref)`` (:func:`passive_torque`), ``sgn = sign`` when
+``eps`` is 0 and ``tanh(qd / eps)`` otherwise, as the numeric ``rnea``. Each may be a number or
+an expression; numbers are checked as :class:`robodyn.Model` checks them (``damping``,
+``coulomb``, ``stiffness``, ``armature`` and ``coulomb_smoothing`` finite and non-negative,
+``spring_reference`` finite), and so are symbols declared negative or infinite.
 """
 
 from __future__ import annotations
@@ -30,9 +40,11 @@ from typing import Sequence
 import numpy as np
 import sympy as sp
 
+import warnings
+
 from .._deprecated import renamed_attribute, renamed_keywords
 from .. import joints as J
-from ..errors import ModelError
+from ..errors import ModelError, RobodynWarning
 
 JOINT_TYPES = ("revolute", "prismatic")
 PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
@@ -101,6 +113,40 @@ def inertia_symbols(body: int) -> list[sp.Symbol]:
 
 
 OLD_FIELDS = dict(axis="joint_axis", R_tree="X_tree_R", p_tree="X_tree_p", inertia="theta")
+# The per-joint passive elements: (field, must be non-negative).
+PASSIVE_FIELDS = (("damping", True), ("coulomb", True), ("stiffness", True), ("spring_reference", False))
+
+
+def passive_value(x, what: str, nonnegative: bool) -> sp.Expr:
+    """``x`` exact (:func:`exact`), checked as :class:`robodyn.Model` checks its friction and
+    spring entries: finite, and non-negative when ``nonnegative``; symbols pass unless their
+    assumptions contradict it (``ModelError`` naming ``what``)."""
+    try:
+        e = exact(x)
+    except (TypeError, ValueError) as err:
+        raise ModelError(f"{what}: {err}") from None
+    if e.is_finite is False or e.has(sp.nan, sp.zoo):
+        raise ModelError(f"{what} must be finite, got {e}")
+    if nonnegative and e.is_negative:
+        raise ModelError(f"{what} must be non-negative, got {e}")
+    return e
+
+
+def passive_torque(model: "SymbolicModel", k: int) -> sp.Expr:
+    """The passive force of joint ``k`` (0-based) opposed by its actuator:
+    ``damping qd + coulomb sgn(qd) + stiffness (q - spring_reference)`` with ``sgn = sign``
+    when ``coulomb_smoothing`` is 0 and ``tanh(qd / coulomb_smoothing)`` otherwise (the numeric
+    ``robodyn.joint_kernels.passive_torque``); zero coefficients fold away."""
+    q, qd, eps = model.q[k], model.v[k], model.coulomb_smoothing
+    sgn = sp.sign(qd) if eps == 0 else sp.tanh(qd / eps)
+    return (model.damping[k] * qd + model.coulomb[k] * sgn
+            + model.stiffness[k] * (q - model.spring_reference[k]))
+
+
+def spring_energy(model: "SymbolicModel") -> sp.Expr:
+    """The energy stored in the joint springs, ``sum_k stiffness_k (q_k - spring_reference_k)^2 / 2``."""
+    return sum((K * (q - r) ** 2 / 2 for K, q, r in zip(model.stiffness, model.q, model.spring_reference)),
+               sp.Integer(0))
 
 
 @dataclass(frozen=True)
@@ -110,8 +156,11 @@ class SymbolicModel:
     Per body ``i`` (``nb`` bodies, each with one joint): ``parent[i]`` (``-1``: the world),
     ``joint_type[i]`` (``"revolute"`` or ``"prismatic"``), ``joint_axis[i]`` (3 x 1, unit,
     body frame), ``X_tree_R[i]`` (3 x 3) and ``X_tree_p[i]`` (3 x 1) (joint frame in the parent
-    frame), ``theta[i]`` (10 inertial parameters): the names of :class:`robodyn.Model`. Per joint: ``armature`` (rotor inertia on the diagonal of
-    ``M``). ``gravity`` (3 x 1, world frame). ``q``, ``qd``, ``qdd``: the joint symbols.
+    frame), ``theta[i]`` (10 inertial parameters): the names of :class:`robodyn.Model`. Per
+    joint: ``armature`` (rotor inertia on the diagonal of ``M``), ``damping``, ``coulomb``,
+    ``stiffness`` and ``spring_reference`` (the passive forces, module docstring; empty tuples
+    mean zeros). ``coulomb_smoothing``: the smoothing velocity of the Coulomb friction (0:
+    ``sign``). ``gravity`` (3 x 1, world frame). ``q``, ``v``, ``a``: the joint symbols.
     """
 
     parent: tuple
@@ -125,6 +174,11 @@ class SymbolicModel:
     name: str = "robot"
     link_names: tuple = ()
     joint_names: tuple = ()
+    damping: tuple = ()
+    coulomb: tuple = ()
+    stiffness: tuple = ()
+    spring_reference: tuple = ()
+    coulomb_smoothing: sp.Expr = 0
     q: tuple = field(init=False)
     v: tuple = field(init=False)
     a: tuple = field(init=False)
@@ -148,10 +202,13 @@ class SymbolicModel:
         set_("X_tree_p", tuple(exact_vector(p, 3, f"X_tree_p[{i}]") for i, p in enumerate(self.X_tree_p)))
         set_("theta", tuple(tuple(exact(t) for t in th) for th in self.theta))
         set_("gravity", exact_vector(self.gravity, 3, "gravity"))
-        arm = tuple(exact(a) for a in self.armature) if self.armature else (sp.Integer(0),) * nb
-        if len(arm) != nb:
-            raise ModelError(f"armature: expected {nb} entries, got {len(arm)}")
-        set_("armature", arm)
+        for what, nonnegative in (("armature", True), *PASSIVE_FIELDS):
+            values = tuple(getattr(self, what))
+            if values and len(values) != nb:
+                raise ModelError(f"{what}: expected {nb} entries (one per joint), got {len(values)}")
+            set_(what, tuple(passive_value(x, f"{what}[{k}]", nonnegative) for k, x in enumerate(values))
+                 if values else (sp.Integer(0),) * nb)
+        set_("coulomb_smoothing", passive_value(self.coulomb_smoothing, "coulomb_smoothing", True))
         set_("link_names", tuple(self.link_names) or tuple(f"link{i + 1}" for i in range(nb)))
         set_("joint_names", tuple(self.joint_names) or tuple(f"joint{i + 1}" for i in range(nb)))
         set_("q", tuple(sp.Symbol(f"q{k + 1}", real=True) for k in range(nb)))
@@ -177,9 +234,15 @@ class SymbolicModel:
         for i in range(self.nbodies):
             for x in (self.joint_axis[i], self.X_tree_R[i], self.X_tree_p[i]):
                 syms |= x.free_symbols
-            for t in (*self.theta[i], self.armature[i]):
+            for t in (*self.theta[i], self.armature[i], *(getattr(self, f)[i] for f, _ in PASSIVE_FIELDS)):
                 syms |= t.free_symbols
+        syms |= self.coulomb_smoothing.free_symbols
         return sorted(syms, key=lambda s: s.name)
+
+    def rigid(self) -> "SymbolicModel":
+        """The model without the passive elements (``damping``, ``coulomb``, ``stiffness``,
+        ``spring_reference`` and ``armature`` zero), as :meth:`robodyn.Model.rigid`."""
+        return self.replace(armature=(), damping=(), coulomb=(), stiffness=(), spring_reference=())
 
     @renamed_keywords(**OLD_FIELDS)
     def replace(self, **changes) -> "SymbolicModel":
@@ -204,7 +267,10 @@ SymbolicModel.__init__ = renamed_keywords(**OLD_FIELDS)(SymbolicModel.__init__)
 
 def from_model(model) -> SymbolicModel:
     """The :class:`SymbolicModel` of a numeric :class:`robodyn.Model` with exact numbers
-    (module docstring). Revolute and prismatic joints on a fixed base only."""
+    (module docstring): geometry, inertias, gravity and the joints' armature, damping,
+    Coulomb friction (with its smoothing) and springs. Revolute and prismatic joints on a
+    fixed base only. Stribeck friction, when the model has it, is not in the closed forms
+    (a :class:`robodyn.RobodynWarning` says so)."""
     if isinstance(model, SymbolicModel):
         return model
     for kind in (J.SPHERICAL, J.HELICAL, J.PLANAR):
@@ -216,6 +282,11 @@ def from_model(model) -> SymbolicModel:
             f"model {model.name!r} has a floating base (free joint); robodyn.symbolic derives "
             "fixed-base trees of revolute and prismatic joints only"
         )
+    stribeck = np.asarray(getattr(model, "stribeck", np.zeros(0)), dtype=float)
+    if np.any(stribeck != 0):
+        warnings.warn(f"model {model.name!r}: the Stribeck friction of dofs {np.flatnonzero(stribeck).tolist()} is "
+                      "not in the symbolic closed forms (damping, Coulomb friction and springs are)",
+                      RobodynWarning, stacklevel=2)
     return SymbolicModel(
         parent=tuple(model.parent.tolist()),
         joint_type=tuple(J.NAMES[t] for t in model.joint_type),
@@ -228,6 +299,11 @@ def from_model(model) -> SymbolicModel:
         name=model.name,
         link_names=model.link_names,
         joint_names=model.body_joint_names,
+        damping=tuple(exact(x) for x in model.damping),
+        coulomb=tuple(exact(x) for x in model.coulomb),
+        stiffness=tuple(exact(x) for x in model.stiffness),
+        spring_reference=tuple(exact(x) for x in model.spring_reference),
+        coulomb_smoothing=exact(model.coulomb_smoothing),
     )
 
 
@@ -263,8 +339,8 @@ def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Ra
     """A serial chain from a DH table whose entries are sympy expressions or numbers.
 
     ``links``: :class:`robodyn.DHLink` rows (``a, alpha, d, offset, joint, theta, mass, com,
-    inertia`` are read; ``inertia`` is 3 x 3 about the centre of mass in DH frame ``i``,
-    ``com`` in DH frame ``i``, as in :func:`robodyn.from_dh`). Standard DH:
+    inertia, armature, damping, coulomb`` are read; ``inertia`` is 3 x 3 about the centre of
+    mass in DH frame ``i``, ``com`` in DH frame ``i``, as in :func:`robodyn.from_dh`). Standard DH:
     ``T_{i-1,i} = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; modified (Craig):
     ``T_{i-1,i} = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i) Tz(d_i)``, with
     ``theta_i = q_i + offset`` (revolute) or ``d_i = q_i + offset`` (prismatic).
@@ -309,6 +385,7 @@ def from_dh(links: Sequence, convention: str = "standard", gravity=(0, 0, -sp.Ra
         parent=tuple(range(-1, n - 1)), joint_type=tuple(types), joint_axis=tuple([0, 0, 1] for _ in range(n)),
         X_tree_R=tuple(R_tree), X_tree_p=tuple(p_tree), theta=tuple(inertia), gravity=list(gravity),
         armature=tuple(getattr(L, "armature", 0) for L in links), name=name,
+        damping=tuple(getattr(L, "damping", 0) for L in links), coulomb=tuple(getattr(L, "coulomb", 0) for L in links),
     )
 
 

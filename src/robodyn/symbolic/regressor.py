@@ -4,8 +4,9 @@ The joint forces of the rigid bodies are linear in the inertial parameters
 ``theta = [m1, mx1, my1, mz1, Ixx1, Ixy1, Iyy1, Ixz1, Iyz1, Izz1, m2, ...]`` (about each
 body origin, robodyn's order; :func:`.model.with_inertia_symbols`). The model's parameters
 are made symbols, ``tau`` is derived exactly (:mod:`.newton_euler` or :mod:`.lagrange`), and
-``Y_ij = d tau_i / d theta_j``. Armature and friction are not inertial parameters and are
-not in ``Y``: ``rnea(model, q, v, a, friction=False, armature=False) = Y theta``.
+``Y_ij = d tau_i / d theta_j``. Armature, friction and joint springs are not inertial parameters and
+are not in ``Y``: ``rnea(model, q, v, a, friction=False, armature=False) = Y theta`` (the
+numeric :func:`robodyn.regressor` has columns for them).
 Reference: W. Khalil, E. Dombre, *Modeling, Identification and Control of Robots*, Hermes
 2002, chapter 12.
 """
@@ -67,11 +68,10 @@ class Regressor:
 
 def regressor(model, method: str = "newton_euler") -> Regressor:
     """The regressor of ``model`` (numeric or symbolic; its inertial parameters are replaced
-    by the symbols ``m1, mx1, ...``, its armature left out)."""
+    by the symbols ``m1, mx1, ...``, its armature, friction and springs left out)."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
-    sm = with_inertia_symbols(from_model(model))
-    sm = sm.replace(armature=(0,) * sm.nbodies)
+    sm = with_inertia_symbols(from_model(model)).rigid()
     rg = TrigRing(sm)
     tau = METHODS[method](rg)["tau"]
     theta = [rg.const(t) for t in sm.inertial_parameters()]
