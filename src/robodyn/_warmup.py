@@ -58,6 +58,7 @@ def _algorithm_steps(rd, model, q, v, a):
         ("nonlinear_effects_derivatives", lambda: rd.nonlinear_effects_derivatives(model, q, v)),
         ("generalized_momentum_derivatives", lambda: rd.generalized_momentum_derivatives(model, q, v)),
         ("constrained_dynamics", lambda: rd.constrained_dynamics(model, q, v, a, [point])),
+        ("constrained_dynamics_derivatives", lambda: rd.constrained_dynamics_derivatives(model, q, v, a, [point])),
         ("task_space_inertia", lambda: rd.task_space_inertia(model, q, last, rows="linear")),
         ("dynamically_consistent_inverse", lambda: rd.dynamically_consistent_inverse(model, q, last, rows="linear")),
         ("task_space_dynamics", lambda: rd.task_space_dynamics(model, q, v, last, rows="linear")),
@@ -102,13 +103,14 @@ def _public():
     from types import ModuleType, SimpleNamespace
 
     from . import random
-    from .algorithms import (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives,
-                             hybrid, inertia_bounds, integrate, jacobian, kinematics, mass_jacobians, minv,
-                             regressor, rnea, rnea_derivatives, task_space, terms)
+    from .algorithms import (aba, aba_derivatives, com, constrained, constrained_derivatives, coriolis, crba,
+                             energy, frame_derivatives, hybrid, inertia_bounds, integrate, jacobian, kinematics,
+                             mass_jacobians, minv, regressor, rnea, rnea_derivatives, task_space, terms)
     from .simulation import rollout, simulate
 
     names = {}
-    for module in (aba, aba_derivatives, com, constrained, coriolis, crba, energy, frame_derivatives, hybrid,
+    for module in (aba, aba_derivatives, com, constrained, constrained_derivatives, coriolis, crba, energy,
+                   frame_derivatives, hybrid,
                    inertia_bounds, integrate, jacobian, kinematics, mass_jacobians, minv, regressor, rnea,
                    rnea_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module)
