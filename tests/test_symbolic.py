@@ -727,6 +727,35 @@ def test_cli_derive_expanded_form(tmp_path, capsys):
                    f"tau ({form})")
 
 
+def test_cli_derive_with_and_without_friction(tmp_path, capsys):
+    """``tau`` of the written C code carries the joints' damping and Coulomb friction, or leaves
+    them out with ``--no-friction`` (as ``rnea(friction=False)``)."""
+    from robodyn.cli import main
+
+    urdf = tmp_path / "rub.urdf"
+    urdf.write_text("""<robot name="rub">
+  <link name="base"/>
+  <link name="a"><inertial><origin xyz="0.3 0 0"/><mass value="2"/>
+    <inertia ixx="0.01" iyy="0.02" izz="0.02" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <link name="b"><inertial><origin xyz="0.2 0 0"/><mass value="1"/>
+    <inertia ixx="0.01" iyy="0.01" izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="a"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="10" velocity="5"/><dynamics damping="0.4" friction="0.3"/></joint>
+  <joint name="j2" type="revolute"><parent link="a"/><child link="b"/><origin xyz="0.6 0 0"/><axis xyz="0 1 0"/>
+    <limit lower="-3" upper="3" effort="10" velocity="5"/><dynamics damping="0.2" friction="0.1"/></joint>
+</robot>""")
+    model = rd.load_urdf(urdf)
+    q, qd, qdd = np.array([0.3, -1.1]), np.array([0.5, -0.2]), np.array([1.0, -2.0])
+    for flags, friction in (([], True), (["--no-friction"], False)):
+        cdir = tmp_path / f"c{friction}"
+        assert main(["derive", str(urdf), "--c", str(cdir), *flags]) == 0
+        assert f"{'with' if friction else 'without'} the joints' friction" in capsys.readouterr().out
+        lib = compile_c({"rub_dynamics.c": None, "rub_dynamics.h": None}, cdir, f"rub{friction}")
+        assert_rel(call_c(lib.rub_tau, 2, q, qd, qdd), rd.rnea(model, q, qd, qdd, friction=friction), 1e-12,
+                   f"tau (friction={friction})")
+    assert np.abs(rd.rnea(model, q, qd, qdd) - rd.rnea(model, q, qd, qdd, friction=False)).min() > 0.1
+
+
 def test_cli_derive_errors(capsys):
     from robodyn.cli import main
 

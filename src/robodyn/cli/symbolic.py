@@ -1,4 +1,5 @@
-"""``robodyn derive MODEL [--method lagrange|newton_euler] [--latex FILE] [--c DIR] [--form auto|expanded]``."""
+"""``robodyn derive MODEL [--method lagrange|newton_euler] [--latex FILE] [--c DIR] [--form auto|expanded]
+[--no-friction]``."""
 
 from __future__ import annotations
 
@@ -18,10 +19,11 @@ def run_derive(model, args) -> int:
     from ..symbolic.equations import equations_of_motion  # imports sympy
 
     t0 = time.perf_counter()
-    eom = equations_of_motion(model, method=args.method)
+    eom = equations_of_motion(model, method=args.method, friction=not args.no_friction)
     t1 = time.perf_counter()
+    passive = "without" if args.no_friction else "with"
     print(f"robodyn derive {model.name!r}: {eom.n} joints, {args.method.replace('_', '-')} method, "
-          f"derived in {t1 - t0:.2f} s")
+          f"{passive} the joints' friction and springs (tau_p), derived in {t1 - t0:.2f} s")
     sizes = {name: sum(len(x) for row in p for x in (row if isinstance(row, list) else [row]))
              if isinstance(p, list) else len(p) for name, p in eom.polynomials.items()}
     print("  terms (monomials): " + ", ".join(f"{k} {sizes[k]}" for k in ("M", "C", "g", "T", "U", "tau")))
@@ -55,4 +57,6 @@ def add_commands(sub) -> None:
     p.add_argument("--form", choices=("auto", "expanded"), default="auto",
                    help="how the C code evaluates the terms: auto (M, g, tau by the recursions, C expanded) "
                         "or expanded (every term expanded)")
+    p.add_argument("--no-friction", action="store_true",
+                   help="leave the joints' friction and springs (tau_p) out of tau and U, as rnea(friction=False)")
     p.set_defaults(func=cmd_derive)
