@@ -10,6 +10,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
+import pinocchio as pin
 import pytest
 from scipy.spatial.transform import Rotation
 
@@ -171,8 +172,7 @@ def test_kkt_identities(model):
     assert [x.shape for x in free[3:]] == [(0, model.nv)] * 3
 
 
-# -- against Pinocchio ------------------------------------------------------------------------
-pin = pytest.importorskip("pinocchio")
+# -- against Pinocchio (a test dependency) -----------------------------------------------------
 
 
 def _pinocchio(model, q, v, tau, contacts, baumgarte=(0.0, 0.0)):
