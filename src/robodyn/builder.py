@@ -29,6 +29,8 @@ Example::
 
 from __future__ import annotations
 
+import math
+import operator
 import warnings
 from dataclasses import dataclass, field
 
@@ -37,7 +39,7 @@ import numpy as np
 from . import joints as J
 from .errors import RobodynWarning
 from .model import (Model, ModelError, check_inertial_parameters, consistent_inertial_parameters,
-                    inertial_parameters_from, inertial_parameters_in_parent)
+                    inertial_parameters_from)
 
 WORLD = "world"  # a joint's parent link of this name needs no add_link: the fixed root
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
@@ -55,9 +57,57 @@ def rpy_to_matrix(rpy) -> np.ndarray:
     ])
 
 
+def _rpy_matrices(rpy) -> np.ndarray:
+    """:func:`rpy_to_matrix` of many angle triples ``rpy`` (n, 3) at once, (n, 3, 3): the same
+    operations, element for element."""
+    rpy = np.asarray(rpy, dtype=float).reshape(-1, 3)
+    (cr, cp, cy), (sr, sp, sy) = np.cos(rpy).T, np.sin(rpy).T
+    R = np.empty((rpy.shape[0], 3, 3))
+    R[:, 0, 0], R[:, 0, 1], R[:, 0, 2] = cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr
+    R[:, 1, 0], R[:, 1, 1], R[:, 1, 2] = sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr
+    R[:, 2, 0], R[:, 2, 1], R[:, 2, 2] = -sp, cp * sr, cp * cr
+    return R
+
+
+def _matvec(A, x) -> np.ndarray:
+    """``A[k] @ x[k]`` for every k, (n, 3): the matrix-vector product of NumPy for one pair."""
+    return (A @ x[:, :, None])[:, :, 0]
+
+
+def _dot(x, y) -> np.ndarray:
+    """``x[k] @ y[k]`` for every k, (n,): the dot product of NumPy for one pair."""
+    return (x[:, None, :] @ y[:, :, None])[:, 0, 0]
+
+
+def _parameters_from(mass, com, inertia_com) -> np.ndarray:
+    """:func:`~robodyn.model.inertial_parameters_from` of n bodies at once, (n, 10): ``mass``
+    (n,), ``com`` (n, 3), ``inertia_com`` (n, 3, 3); the same operations, body for body."""
+    m, c = mass[:, None, None], com
+    Io = inertia_com + m * (_dot(c, c)[:, None, None] * np.eye(3) - c[:, :, None] * c[:, None, :])
+    h = mass[:, None] * c
+    return np.column_stack([mass, h, Io[:, 0, 0], Io[:, 0, 1], Io[:, 1, 1], Io[:, 0, 2], Io[:, 1, 2], Io[:, 2, 2]])
+
+
+def _parameters_in_parent(R, p, theta) -> np.ndarray:
+    """:func:`~robodyn.model.inertial_parameters_in_parent` of n bodies at once, (n, 10): ``R``
+    (n, 3, 3), ``p`` (n, 3), ``theta`` (n, 10); the same operations, body for body."""
+    n = theta.shape[0]
+    m = theta[:, 0]
+    hr = _matvec(R, theta[:, 1:4])
+    Io = theta[:, [4, 5, 7, 5, 6, 8, 7, 8, 9]].reshape(n, 3, 3)
+    s = _dot(2.0 * p, hr) + m * _dot(p, p)
+    I = (R @ Io @ R.transpose(0, 2, 1) - p[:, :, None] * hr[:, None, :] - hr[:, :, None] * p[:, None, :]
+         + s[:, None, None] * np.eye(3) - m[:, None, None] * (p[:, :, None] * p[:, None, :]))
+    h = hr + m[:, None] * p
+    return np.column_stack([m, h, I[:, 0, 0], I[:, 0, 1], I[:, 1, 1], I[:, 0, 2], I[:, 1, 2], I[:, 2, 2]])
+
+
 @dataclass
 class LinkEntry:
-    """A link as added: its 10 inertial parameters and where it was defined."""
+    """A link as added: its 10 inertial parameters and where it was defined. ``where`` is text,
+    or an object whose ``str`` is that text (a loader's, made only when a message needs it);
+    ``theta`` is None for a link added by :meth:`ModelBuilder._add_link_values` until
+    :meth:`ModelBuilder.build`."""
 
     name: str
     theta: np.ndarray
@@ -75,7 +125,9 @@ class LinkEntry:
 
 @dataclass
 class JointEntry:
-    """A joint as added: type, parent and child links, placement, axis, limits."""
+    """A joint as added: type, parent and child links, placement, axis, limits (``R``, ``p``
+    and ``axis`` are None for a joint added by :meth:`ModelBuilder._add_joint_values` until
+    :meth:`ModelBuilder.build`; ``where`` as in :class:`LinkEntry`)."""
 
     name: str
     type: str
@@ -87,6 +139,12 @@ class JointEntry:
     limits: dict = field(default_factory=dict)
     where: str = ""
     pitch: float = 0.0
+
+
+_FREE_LIMITS = dict(lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0,
+                    armature=0.0, stiffness=0.0, spring_reference=0.0)
+_LIMIT_KEYS = tuple(_FREE_LIMITS)
+_limit_values = operator.itemgetter(*_LIMIT_KEYS)
 
 
 class ModelBuilder:
@@ -105,6 +163,9 @@ class ModelBuilder:
         self.source = source
         self._links: dict[str, LinkEntry] = {}
         self._joints: list[JointEntry] = []
+        # links and joints added from plain numbers, whose arrays build() computes at once
+        self._pending_links: list[tuple] = []
+        self._pending_joints: list[tuple] = []
 
     def add_link(self, name: str, mass: float = 0.0, com=(0.0, 0.0, 0.0), inertia=None,
                  inertia_rotation=None, where: str | None = None) -> None:
@@ -128,6 +189,21 @@ class ModelBuilder:
             raise ModelError(f"{where}: negative mass {mass}")
         self._links[name] = LinkEntry(name, inertial_parameters_from(mass, com, Ic), where)
 
+    def _add_link_values(self, name: str, mass: float, com: tuple, inertia: tuple | None, rpy: tuple | None,
+                         where) -> None:
+        """:meth:`add_link` from finite floats (a loader's fast path): ``com`` (x, y, z),
+        ``inertia`` ``(ixx, ixy, ixz, iyy, iyz, izz)`` or None, its axes rotated by the
+        roll-pitch-yaw angles ``rpy`` (``rotation=rpy_to_matrix(rpy)``) or None; ``where`` text
+        or an object formatting to it. The same checks and, in :meth:`build`, bit for bit the
+        same parameters as :meth:`add_link` (finite and symmetric by construction)."""
+        if name in self._links:
+            raise ModelError(f"{where}: duplicate link name {name!r} (first defined at {self._links[name].where})")
+        if mass < 0:
+            raise ModelError(f"{where}: negative mass {mass}")
+        entry = LinkEntry(name, None, where)
+        self._links[name] = entry
+        self._pending_links.append((entry, mass, com, inertia, rpy))
+
     def _check_body(self, theta, name: str, links: list[LinkEntry]) -> None:
         """Check the merged body ``name`` (``theta``), made of ``links``; raise (or warn, with
         ``physical="warn"``) naming each link and what it carries."""
@@ -143,9 +219,10 @@ class ModelBuilder:
         for k in links:
             m, h = k.theta[0], k.theta[1:4]
             com = (h / m).round(6).tolist() if m > 0 else "-"
-            place = k.where[len(self.source) + 2:] if k.where.startswith(f"{self.source}: ") else k.where
+            k_where = str(k.where)
+            place = k_where[len(self.source) + 2:] if k_where.startswith(f"{self.source}: ") else k_where
             issue = k.issue() if len(links) > 1 else ""
-            alone = issue[len(k.where) + 2:] if issue else ""
+            alone = issue[len(k_where) + 2:] if issue else ""
             parts.append(f"{place}: mass {m:.6g}, com {com}" + (f", alone: {alone}" if alone else ""))
         message += "; made of " + "; ".join(parts)
         if self.physical == "warn":
@@ -199,26 +276,61 @@ class ModelBuilder:
             if n < 1e-12:
                 raise ModelError(f"{where}: joint axis is zero")
             ax = ax / n
+        limits = self._limits(type, where, lower, upper, velocity, effort, damping, friction, armature, stiffness,
+                              spring_reference)
+        if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
+            raise ModelError(f"{where}: pitch {pitch} on a {type} joint (only a helical joint has a finite pitch)")
+        self._joints.append(JointEntry(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
+
+    def _add_joint_values(self, name: str, type: str, parent: str, child: str, xyz: tuple, rpy: tuple,
+                          axis: tuple, where, **limits) -> None:
+        """:meth:`add_joint` from finite floats (a loader's fast path): ``xyz``, ``rpy`` and
+        ``axis`` triples, the limits as keywords (floats); ``where`` text or an object
+        formatting to it. The same checks and errors, in the same order, and in :meth:`build`
+        bit for bit the same placement and axis as :meth:`add_joint`."""
+        if type not in JOINT_TYPES:  # universal (which needs axis2) or unknown: add_joint says so
+            return self.add_joint(name, type, parent, child, xyz, rpy, axis, where=where, **limits)
+        if type in ("free", "spherical", "planar"):
+            mode = "zero"
+        elif type == "fixed":
+            mode = "raw"
+        else:
+            mode = "unit"
+            a0, a1, a2 = axis
+            if a0 * a0 + a1 * a1 + a2 * a2 < 1e-20 and np.linalg.norm(np.array(axis)) < 1e-12:
+                raise ModelError(f"{where}: joint axis is zero")
+        checked = self._limits(type, where, **limits)
+        entry = JointEntry(name, type, parent, child, None, None, None, checked, where, 0.0)
+        self._joints.append(entry)
+        self._pending_joints.append((entry, xyz, rpy, axis, mode))
+
+    @staticmethod
+    def _limits(type, where, lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0,
+                friction=0.0, armature=0.0, stiffness=0.0, spring_reference=0.0) -> dict:
+        """The checked limits, friction, armature and spring of a joint (:meth:`add_joint`)."""
         if type in ("continuous", "free", "spherical", "planar"):
             lower, upper = -np.inf, np.inf
         limits = dict(lower=float(lower), upper=float(upper), velocity=float(velocity),
                       effort=float(effort), damping=float(damping), friction=float(friction),
                       armature=float(armature), stiffness=float(stiffness), spring_reference=float(spring_reference))
+        lo, hi, vel, eff, damp, fric, arm, stiff, ref = limits.values()
+        inf = math.inf
+        ordinary = (lo == lo and hi == hi and vel >= 0 and eff >= 0 and 0 <= damp < inf and 0 <= fric < inf
+                    and 0 <= arm < inf and 0 <= stiff < inf and -inf < ref < inf)  # the checks below pass
         finite = ("damping", "friction", "armature", "stiffness")
-        for k, val in limits.items():
-            if np.isnan(val):
+        for k, val in () if ordinary else limits.items():
+            if math.isnan(val):
                 raise ModelError(f"{where}: {k} is NaN")
-            if k == "spring_reference" and not np.isfinite(val):
+            if k == "spring_reference" and not math.isfinite(val):
                 raise ModelError(f"{where}: spring_reference must be finite, got {val}")
-            if k not in ("lower", "upper", "spring_reference") and (val < 0 or (k in finite and not np.isfinite(val))):
+            if k not in ("lower", "upper", "spring_reference") and (val < 0
+                                                                   or (k in finite and not math.isfinite(val))):
                 raise ModelError(f"{where}: {k} must be finite and >= 0, got {val}")
         if (stiffness or spring_reference) and type in ("free", "spherical", "planar", "fixed"):
             raise ModelError(f"{where}: joint springs on a {type} joint; only joints of one dof have them")
         if limits["lower"] > limits["upper"]:
             raise ModelError(f"{where}: lower limit {lower} exceeds upper limit {upper}")
-        if not np.isfinite(pitch) or (pitch != 0 and type != "helical"):
-            raise ModelError(f"{where}: pitch {pitch} on a {type} joint (only a helical joint has a finite pitch)")
-        self._joints.append(JointEntry(name, type, parent, child, R, p, ax, limits, where, float(pitch)))
+        return limits
 
     def _add_universal(self, name, parent, child, xyz, rpy, axis, axis2, rotation, where, options) -> None:
         if axis2 is None:
@@ -268,7 +380,7 @@ class ModelBuilder:
             children[jt.parent].append(jt)
         roots = [name for name in self._links if name not in parent_joint]
         if len(roots) > 1:
-            shown = "; ".join(self._links[r].where for r in roots[:5]) + ("; ..." if len(roots) > 5 else "")
+            shown = "; ".join(str(self._links[r].where) for r in roots[:5]) + ("; ..." if len(roots) > 5 else "")
             raise ModelError(f"{self.source}: several root links {roots[:5]} ({shown}); a robot is one tree")
         # every link has at most one parent, so links unreachable from the root lie on cycles
         reached, stack = set(roots), list(roots)
@@ -288,81 +400,164 @@ class ModelBuilder:
             path.append(parent_joint[link])
             link = path[-1].parent
         cycle = path[seen[link]:][::-1]
-        shown = "; ".join(jt.where for jt in cycle[:5]) + ("; ..." if len(cycle) > 5 else "")
+        shown = "; ".join(str(jt.where) for jt in cycle[:5]) + ("; ..." if len(cycle) > 5 else "")
         links = [jt.child for jt in cycle]
         return f"{self.source}: the joints form a cycle through links {links[:5]}{' ...' if len(links) > 5 else ''} ({shown})"
+
+    def _materialize(self) -> None:
+        """The inertial parameters of the links, and the rotation, position and axis of the
+        joints, added from plain numbers since the last build, all at once: the operations of
+        :meth:`add_link` and :meth:`add_joint`, stacked (NumPy's products of one pair and of a
+        stack give the same bits)."""
+        links, joints = self._pending_links, self._pending_joints
+        self._pending_links, self._pending_joints = [], []
+        turned = [k for k, item in enumerate(links) if item[4] is not None]
+        # the rotations of the inertias and of the joints, all at once
+        R = _rpy_matrices([links[k][4] for k in turned] + [item[2] for item in joints])
+        if links:
+            entries, mass, com, inertia, _ = zip(*links)
+            n = len(entries)
+            Ic = np.zeros((n, 3, 3))
+            full = [k for k in range(n) if inertia[k] is not None]
+            if full:
+                Ic[full] = np.array([inertia[k] for k in full])[:, [0, 1, 2, 1, 3, 4, 2, 4, 5]].reshape(-1, 3, 3)
+            if turned:
+                Rr = R[:len(turned)]
+                Ic[turned] = Rr @ Ic[turned] @ Rr.transpose(0, 2, 1)
+            theta = _parameters_from(np.array(mass, dtype=float), np.array(com, dtype=float).reshape(n, 3), Ic)
+            for entry, row in zip(entries, theta):
+                entry.theta = row
+        if joints:
+            entries, xyz, _, axis, mode = zip(*joints)
+            n = len(entries)
+            p = np.array(xyz, dtype=float).reshape(n, 3)
+            ax = np.array(axis, dtype=float).reshape(n, 3)
+            unit = [k for k in range(n) if mode[k] == "unit"]
+            if unit:
+                ax[unit] = ax[unit] / np.sqrt(_dot(ax[unit], ax[unit]))[:, None]
+            ax[[k for k in range(n) if mode[k] == "zero"]] = 0.0
+            for entry, Rk, pk, ak in zip(entries, R[len(turned):], p, ax):
+                entry.R, entry.p, entry.axis = Rk, pk, ak
 
     def build(self, floating_base: bool = False) -> Model:
         """The :class:`Model`; a floating base adds a free joint ``root_joint`` at the root."""
         root, children = self._check_graph()
-        pitch: list[float] = []
-        parent, jtype, axis, XR, Xp, theta = [], [], [], [], [], []
-        names, jnames, dofs = [], [], []
-        frames: list[tuple[str, int, np.ndarray, np.ndarray]] = []
+        self._materialize()
 
-        def new_body(par, code, ax, R, p, name, jname, lim, h=0.0):
-            pitch.append(h)
-            parent.append(par)
-            jtype.append(code)
-            axis.append(ax)
-            XR.append(R)
-            Xp.append(p)
-            theta.append(np.zeros(10))
-            names.append(name)
-            jnames.append(jname)
-            dofs.extend([lim] * int(J.NV[code]))
-            return len(parent) - 1
-
-        free = dict(lower=-np.inf, upper=np.inf, velocity=np.inf, effort=np.inf, damping=0.0, friction=0.0, armature=0.0,
-                    stiffness=0.0, spring_reference=0.0)
-        if floating_base:
-            b = new_body(-1, J.FREE, np.zeros(3), np.eye(3), np.zeros(3), root, "root_joint", free)
-            place = {root: (b, np.eye(3), np.zeros(3))}
-        else:
-            place = {root: (-1, np.eye(3), np.zeros(3))}
-            frames.append((root, -1, np.eye(3), np.zeros(3)))
+        # Pass 1: bodies and frames in depth-first order (children in the order added). Every
+        # link lies in a body; a link that a fixed joint carries is placed in its body's frame
+        # by that joint (``carrier``), the others are their body's origin.
+        body_of: dict[str, int] = {root: 0 if floating_base else -1}
+        carrier: dict[str, int] = {root: -1}  # link -> the position in ``visited`` of its fixed joint
+        body_joint: list[int] = [-1] if floating_base else []  # each body's joint (position in ``visited``)
+        names = [root] if floating_base else []
+        frames: list[tuple[str, int, int]] = [] if floating_base else [(root, -1, -1)]
+        visited: list[JointEntry] = []
         order = [root]
         stack = list(reversed(children[root]))
         while stack:
             jt = stack.pop()
-            b, R, p = place[jt.parent]
-            Rj, pj = R @ jt.R, p + R @ jt.p
+            k = len(visited)
+            visited.append(jt)
+            b = body_of[jt.parent]
             if jt.type == "fixed":
-                place[jt.child] = (b, Rj, pj)
-                frames.append((jt.child, b, Rj, pj))
+                body_of[jt.child], carrier[jt.child] = b, k
+                frames.append((jt.child, b, k))
             elif jt.type == "free" and b >= 0:
                 raise ModelError(
                     f"{jt.where}: a free joint must attach to the world, but its parent link "
                     f"{jt.parent!r} moves with body {names[b]!r}"
                 )
             else:
-                nb = new_body(b, JOINT_TYPES[jt.type], jt.axis, Rj, pj, jt.child, jt.name, jt.limits, jt.pitch)
-                place[jt.child] = (nb, np.eye(3), np.zeros(3))
+                body_of[jt.child], carrier[jt.child] = len(names), -1
+                body_joint.append(k)
+                names.append(jt.child)
             order.append(jt.child)
             stack.extend(reversed(children[jt.child]))
-        members: list[list[LinkEntry]] = [[] for _ in theta]
-        for link in order:
-            b, R, p = place[link]
-            if b < 0:
-                continue  # carried by the fixed world
-            theta[b] += inertial_parameters_in_parent(R, p, self._links[link].theta)
-            members[b].append(self._links[link])
-        suspect = ~consistent_inertial_parameters(np.reshape(theta, (-1, 10))) if theta else []
+
+        # Pass 2: each joint's frame in its parent link's body, R @ R_joint and p + R @ p_joint
+        # with (R, p) the placement of the parent link, computed level by level of fixed joints
+        nj = len(visited)
+        Rj, pj = np.empty((nj, 3, 3)), np.empty((nj, 3))
+        if nj:
+            R_in = np.array([jt.R for jt in visited], dtype=float).reshape(nj, 3, 3)
+            p_in = np.array([jt.p for jt in visited], dtype=float).reshape(nj, 3)
+            src = [carrier[jt.parent] for jt in visited]
+            level = [0] * nj
+            for k, s in enumerate(src):
+                if s >= 0:
+                    level[k] = level[s] + 1
+            by_level: list[list[int]] = [[] for _ in range(max(level) + 1)]
+            for k, lv in enumerate(level):
+                by_level[lv].append(k)
+            for ks in by_level:
+                s = [src[k] for k in ks]
+                if s[0] < 0:  # the parent link is its body's origin (level 0)
+                    R, p = np.eye(3), np.zeros((len(ks), 3))
+                else:
+                    R, p = Rj[s], pj[s]
+                Rj[ks] = R @ R_in[ks]
+                pj[ks] = p + _matvec(np.broadcast_to(R, (len(ks), 3, 3)), p_in[ks])
+
+        # Pass 3: the inertial parameters of each body, its links moved into its frame and
+        # summed in depth-first order
+        nb = len(names)
+        on_body = [link for link in order if body_of[link] >= 0]  # links carried by the fixed world are left out
+        members: list[list[LinkEntry]] = [[] for _ in range(nb)]
+        for link in on_body:
+            members[body_of[link]].append(self._links[link])
+        theta = np.zeros((nb, 10))
+        if on_body:
+            m = len(on_body)
+            R, p = np.empty((m, 3, 3)), np.zeros((m, 3))
+            R[:] = np.eye(3)
+            moved = [i for i, link in enumerate(on_body) if carrier[link] >= 0]
+            if moved:
+                R[moved] = Rj[[carrier[on_body[i]] for i in moved]]
+                p[moved] = pj[[carrier[on_body[i]] for i in moved]]
+            t = np.array([self._links[link].theta for link in on_body], dtype=float).reshape(m, 10)
+            terms = _parameters_in_parent(R, p, t)
+            # theta[b] += term, link after link (np.add.at adds in index order, unbuffered)
+            np.add.at(theta, [body_of[link] for link in on_body], terms)
+        suspect = ~consistent_inertial_parameters(theta) if nb else []
         for i in np.flatnonzero(suspect):
             self._check_body(theta[i], names[i], members[i])
 
-        def col(key):
-            return np.array([d[key] for d in dofs], dtype=float)
-
-        nb = len(parent)
+        # The model's arrays: bodies (X_tree, axis, limits per dof) and frames
+        jtype, parent, axis, pitch, jnames, dofs = [], [], [], [], [], []
+        for k in body_joint:
+            if k < 0:  # the floating base
+                code, par, ax, h, jname, lim = J.FREE, -1, np.zeros(3), 0.0, "root_joint", _FREE_LIMITS
+            else:
+                jt = visited[k]
+                code, par, ax, h = JOINT_TYPES[jt.type], body_of[jt.parent], jt.axis, jt.pitch
+                jname, lim = jt.name, jt.limits
+            jtype.append(code)
+            parent.append(par)
+            axis.append(ax)
+            pitch.append(h)
+            jnames.append(jname)
+            dofs.extend([lim] * int(J.NV[code]))
+        moving = [k for k in body_joint if k >= 0]
+        X_R = np.empty((nb, 3, 3))
+        X_p = np.empty((nb, 3))
+        if floating_base:
+            X_R[0], X_p[0] = np.eye(3), np.zeros(3)
+        X_R[nb - len(moving):], X_p[nb - len(moving):] = Rj[moving], pj[moving]
+        nf = len(frames)
+        frame_R, frame_p = np.empty((nf, 3, 3)), np.zeros((nf, 3))
+        frame_R[:] = np.eye(3)
+        placed = [f for f in range(nf) if frames[f][2] >= 0]  # all but the root's frame
+        by = [frames[f][2] for f in placed]
+        frame_R[placed], frame_p[placed] = Rj[by], pj[by]
+        columns = np.array(list(map(_limit_values, dofs)), dtype=float).reshape(len(dofs), 9)
+        col = dict(zip(_LIMIT_KEYS, columns.T))
         return Model(
             parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)), joint_pitch=pitch,
-            X_tree_R=np.reshape(XR, (nb, 3, 3)), X_tree_p=np.reshape(Xp, (nb, 3)),
-            theta=np.reshape(theta, (nb, 10)), link_names=names, body_joint_names=jnames, physical=self.physical,
-            gravity=self.gravity, lower=col("lower"), upper=col("upper"),
-            velocity_limit=col("velocity"), effort_limit=col("effort"), damping=col("damping"),
-            coulomb=col("friction"), armature=col("armature"), stiffness=col("stiffness"),
-            spring_reference=col("spring_reference"), frame_names=[f[0] for f in frames], frame_body=[f[1] for f in frames],
-            frame_R=np.reshape([f[2] for f in frames], (len(frames), 3, 3)),
-            frame_p=np.reshape([f[3] for f in frames], (len(frames), 3)), name=self.name,
+            X_tree_R=X_R, X_tree_p=X_p, theta=theta, link_names=names, body_joint_names=jnames,
+            physical=self.physical, gravity=self.gravity, lower=col["lower"], upper=col["upper"],
+            velocity_limit=col["velocity"], effort_limit=col["effort"], damping=col["damping"],
+            coulomb=col["friction"], armature=col["armature"], stiffness=col["stiffness"],
+            spring_reference=col["spring_reference"], frame_names=[f[0] for f in frames],
+            frame_body=[f[1] for f in frames], frame_R=frame_R, frame_p=frame_p, name=self.name,
         )

@@ -76,30 +76,72 @@ class KernelTables(NamedTuple):
     multi_dof_bodies: tuple
 
 
+_AXIAL_CODE = np.isin(np.arange(len(J.NAMES)), J.AXIAL)  # joint type code -> has an axis
+
+
+def _axial_constants(jtype, axis, R, pitch) -> np.ndarray:
+    """:func:`joints.joint_constants` of bodies whose joints have an axis (revolute, helical,
+    prismatic), all at once (n, JOINT_CONSTANTS_SIZE): the same operations, body for body
+    (NumPy's products of one pair and of a stack give the same bits)."""
+    n = jtype.shape[0]
+    out = np.zeros((n, J.JOINT_CONSTANTS_SIZE))
+    Ra = (R @ axis[:, :, None])[:, :, 0]  # R_tree @ axis
+    turn = (jtype == J.REVOLUTE) | (jtype == J.HELICAL)
+    a, Rt, C = axis[turn], R[turn], Ra[turn][:, :, None] * axis[turn][:, None, :]
+    skew = np.zeros((a.shape[0], 3, 3))
+    skew[:, 0, 1], skew[:, 0, 2], skew[:, 1, 0] = -a[:, 2], a[:, 1], a[:, 2]
+    skew[:, 1, 2], skew[:, 2, 0], skew[:, 2, 1] = -a[:, 0], -a[:, 1], a[:, 0]
+    out[turn, 0:9], out[turn, 9:18] = C.reshape(-1, 9), (Rt - C).reshape(-1, 9)
+    out[turn, 18:27] = (Rt @ skew).reshape(-1, 9)
+    helical = jtype == J.HELICAL
+    out[helical, 27:30] = pitch[helical, None] * Ra[helical]
+    out[jtype == J.PRISMATIC, 0:3] = Ra[jtype == J.PRISMATIC]
+    return out
+
+
+def _axial_subspaces(jtype, axis, pitch) -> np.ndarray:
+    """:func:`joints.motion_subspace` of bodies whose joints have an axis (their one column,
+    (n, 6)), the same values: ``[0, axis]`` revolute, ``[pitch axis, axis]`` helical, ``[axis, 0]``
+    prismatic."""
+    S = np.zeros((jtype.shape[0], 6))
+    helical, prismatic = jtype == J.HELICAL, jtype == J.PRISMATIC
+    S[~prismatic, 3:6] = axis[~prismatic]
+    S[helical, 0:3] = pitch[helical, None] * axis[helical]
+    S[prismatic, 0:3] = axis[prismatic]
+    return S
+
+
 def pack(model) -> KernelTables:
     """The kernel tables of ``model`` (any object with the :class:`Model`'s arrays)."""
     nb, nv = model.nbodies, model.nv
+    jtype = np.asarray(model.joint_type)
     ints = np.zeros((nb, INTS_COLUMNS), dtype=np.int64)
     ints[:, PARENT] = model.parent
     ints[:, JTYPE] = model.joint_type
     ints[:, IQ] = model.idx_q
     ints[:, IV] = model.idx_v
     ints[:, NDOF] = J.NV[model.joint_type] if nb else 0
-    ints[:, SUBTREE_END] = ints[:, IV] + ints[:, NDOF]
+    end = (ints[:, IV] + ints[:, NDOF]).tolist()
+    parents = ints[:, PARENT].tolist()
     for i in range(nb - 1, 0, -1):  # children after their parents: the ends gather to the root
-        p = model.parent[i]
-        if p >= 0:
-            ints[p, SUBTREE_END] = max(ints[p, SUBTREE_END], ints[i, SUBTREE_END])
+        p = parents[i]
+        if p >= 0 and end[i] > end[p]:
+            end[p] = end[i]
+    ints[:, SUBTREE_END] = end
     body = np.zeros((nb, BODY_COLUMNS))
     body[:, XTREE_R:XTREE_R + 9] = model.X_tree_R.reshape(nb, 9)
     body[:, XTREE_P:XTREE_P + 3] = model.X_tree_p
     body[:, JOINT_AXIS:JOINT_AXIS + 3] = model.joint_axis
     body[:, INERTIA:INERTIA_END] = model.theta
-    for i in range(nb):
+    full = np.zeros((nv, DOF_COLUMNS))
+    axial = _AXIAL_CODE[jtype]
+    if axial.any():
+        args = (jtype[axial], np.asarray(model.joint_axis)[axial], np.asarray(model.joint_pitch)[axial])
+        body[axial, JOINT_CONSTANTS:] = _axial_constants(args[0], args[1], np.asarray(model.X_tree_R)[axial], args[2])
+        full[np.asarray(model.idx_v)[axial], MOTION:MOTION + 6] = _axial_subspaces(*args)
+    for i in np.flatnonzero(~axial):  # free, spherical, planar: a few bodies
         body[i, JOINT_CONSTANTS:] = J.joint_constants(int(model.joint_type[i]), model.joint_axis[i],
                                                       model.X_tree_R[i], model.joint_pitch[i])
-    full = np.zeros((nv, DOF_COLUMNS))
-    for i in range(nb):
         k = model.idx_v[i]
         Si = J.motion_subspace(int(model.joint_type[i]), model.joint_axis[i], model.joint_pitch[i])
         full[k:k + Si.shape[0], MOTION:MOTION + 6] = Si
@@ -108,20 +150,16 @@ def pack(model) -> KernelTables:
     full[:, STRIBECK] = model.stribeck
     vs = model.stribeck_velocity
     full[:, STRIBECK_RATE] = np.divide(1.0, vs, out=np.zeros(nv), where=vs > 0)
-    for i in range(nb):
-        S = full[model.idx_v[i], MOTION:MOTION + 6]
-        unit = ints[i, NDOF] == 1 and np.count_nonzero(S) == 1 and S.max() == 1.0
-        ints[i, UNIT_AXIS] = int(np.argmax(S)) if unit else -1
+    S = full[np.asarray(model.idx_v), MOTION:MOTION + 6]  # each body's first dof
+    unit = (ints[:, NDOF] == 1) & (np.count_nonzero(S, axis=1) == 1) & (S.max(1, initial=-np.inf) == 1.0)
+    ints[:, UNIT_AXIS] = np.where(unit, np.argmax(S, axis=1) if nb else 0, -1)
     dofs = {}
     for friction in (False, True):
         for armature in (False, True):
-            d = full.copy()
-            d[:, ARMATURE] *= armature
-            d[:, DAMPING] *= friction
-            d[:, COULOMB] *= friction
-            d[:, STIFFNESS] *= friction
-            d[:, STRIBECK] *= friction
-            dofs[(friction, armature)] = d
+            keep = np.ones(DOF_COLUMNS)  # the columns switched off are multiplied by 0
+            keep[ARMATURE] = armature
+            keep[[DAMPING, COULOMB, STIFFNESS, STRIBECK]] = friction
+            dofs[(friction, armature)] = full * keep
     params = {}
     for with_gravity in (True, False):
         p = np.zeros(PARAMS_SIZE)

@@ -29,6 +29,8 @@ from .errors import ModelError
 from .layout import pack
 
 
+_AXIAL_CODE = np.isin(np.arange(len(J.NAMES)), J.AXIAL)  # joint type code -> has an axis
+
 # Tolerances of the physical-consistency checks of inertias: relative to the largest principal
 # moment, with an absolute floor (kg m^2) for the round-off of bodies with (almost) no inertia.
 INERTIA_RTOL = 1e-6
@@ -211,7 +213,10 @@ class Model:
         jt = np.asarray(joint_type, dtype=np.int64).reshape(-1)
         if jt.shape != (nb,):
             raise ModelError(f"joint_type must have shape ({nb},), got {jt.shape}")
-        for i in range(nb):
+        # every body checked at once; the first that fails is checked again alone, for the message
+        bad = ((parent < -1) | (parent >= np.arange(nb)) | (jt < 0) | (jt >= len(J.NAMES))
+               | ((jt == J.FREE) & (parent != -1)))
+        for i in np.flatnonzero(bad):
             if not (-1 <= parent[i] < i):
                 raise ModelError(f"body {i}: parent index {parent[i]} must satisfy -1 <= parent < {i}")
             if not 0 <= jt[i] < len(J.NAMES):
@@ -248,7 +253,7 @@ class Model:
         # every body checked at once; the bodies that fail are checked again one by one, in
         # order, for the message
         finite = np.isfinite(axis).all(1) & np.isfinite(R).reshape(nb, 9).all(1) & np.isfinite(p).all(1)
-        one_dof = np.isin(jt, J.AXIAL)
+        one_dof = _AXIAL_CODE[jt]
         norms = np.linalg.norm(np.where(finite[:, None], axis, 0.0), axis=1)
         Rf = np.where(finite[:, None, None], R, np.eye(3))
         rotation = ((np.abs(Rf @ Rf.transpose(0, 2, 1) - np.eye(3)).reshape(nb, 9).max(1, initial=0.0) <= 1e-9)
@@ -276,16 +281,23 @@ class Model:
             raise ModelError("gravity is not finite")
 
         free_dof = np.zeros(nv, dtype=bool)  # no position limits on free, spherical, planar joints
-        for i in range(nb):
-            if J.NQ[jt[i]] > 1:
-                free_dof[idx_v[i]:idx_v[i] + nv_i[i]] = True
+        for i in np.flatnonzero(nq_i > 1):
+            free_dof[idx_v[i]:idx_v[i] + nv_i[i]] = True
         lo = arr(lower, (nv,), "lower", -np.inf)
         hi = arr(upper, (nv,), "upper", np.inf)
         lo[free_dof], hi[free_dof] = -np.inf, np.inf
         dofs = {}
-        for key, val, fill in (("velocity_limit", velocity_limit, np.inf), ("effort_limit", effort_limit, np.inf),
-                               ("damping", damping, 0.0), ("coulomb", coulomb, 0.0), ("armature", armature, 0.0),
-                               ("stribeck", stribeck, 0.0), ("stribeck_velocity", stribeck_velocity, 0.0)):
+        per_dof = (("velocity_limit", velocity_limit, np.inf), ("effort_limit", effort_limit, np.inf),
+                   ("damping", damping, 0.0), ("coulomb", coulomb, 0.0), ("armature", armature, 0.0),
+                   ("stribeck", stribeck, 0.0), ("stribeck_velocity", stribeck_velocity, 0.0))
+        try:  # all at once; on any failure, one by one, for the message of the first
+            values = np.array([arr(val, (nv,), key, fill) for key, val, fill in per_dof])
+            checked = not (np.isnan(values).any() or (values < 0).any() or not np.isfinite(values[2:]).all())
+        except Exception:  # noqa: BLE001 - the loop below raises it, after the messages of the keys before
+            checked = False
+        if checked:
+            dofs = {key: a for (key, _, _), a in zip(per_dof, values)}
+        for key, val, fill in () if checked else per_dof:
             a = arr(val, (nv,), key, fill)
             if np.any(np.isnan(a)) or np.any(a < 0):
                 raise ModelError(f"{key} must be non-negative, got {a.tolist()}")
@@ -325,7 +337,7 @@ class Model:
         if len(set(all_names)) != len(all_names):
             dup = sorted({n for n in all_names if all_names.count(n) > 1})
             raise ModelError(f"duplicate link or frame names: {dup}")
-        one_dof = [jnames[i] for i in range(nb) if J.NV[jt[i]] == 1]
+        one_dof = [name for name, n in zip(jnames, nv_i.tolist()) if n == 1]
         if len(set(one_dof)) != len(one_dof):
             raise ModelError("duplicate joint names")
 

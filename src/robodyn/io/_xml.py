@@ -4,6 +4,11 @@ Parsing forbids DTDs, entities and external references (defusedxml), bounds the 
 depth and the size of the input, and records the line of every element so that every error
 can name where it is. A byte-order mark or whitespace before ``<?xml ...?>`` is accepted, as
 the major loaders accept it.
+
+:func:`parse_lazy_lines` (the URDF loader's) reads a text without ``<!DOCTYPE`` with the C tree
+builder of ``xml.etree`` and finds the lines only when a message needs them; any other text,
+and any failure, goes through :func:`parse`: the same elements, attributes, errors and refusals
+(the fast tree also keeps element text, which the loaders do not read).
 """
 
 from __future__ import annotations
@@ -15,12 +20,14 @@ from pathlib import Path
 import numpy as np
 from defusedxml import DefusedXmlException, DTDForbidden
 from defusedxml.ElementTree import DefusedXMLParser, ParseError
-from xml.etree.ElementTree import Element
+from xml.etree.ElementTree import Element, TreeBuilder, XMLParser
 from xml.parsers.expat import ExpatError, errors
 
 from ..errors import ModelError
 
 MAX_DEPTH = 64
+# Texts up to this many characters may take the fast path of :func:`parse_lazy_lines`.
+FAST_PARSE_MAX_CHARS = 8 * 1024 * 1024
 
 
 class LineParser(DefusedXMLParser):
@@ -151,6 +158,59 @@ def parse(text: str, name: str):
             raise ModelError(f"{name}: malformed XML (a namespace prefix that cannot be declared)") from None
     _strip_default_namespace(root)
     return root, lines
+
+
+def parse_lazy_lines(text: str, name: str):
+    """:func:`parse`, about twice as fast: ``(root element, lines)``, where ``lines`` maps
+    ``id(element)`` to its line through ``lines.get`` and finds the lines only when first asked
+    (an error message), by parsing the text again with :func:`parse`.
+
+    The fast path is the C tree builder of ``xml.etree`` (expat, as :func:`parse`), taken when
+    the text has no ``<!DOCTYPE`` (so expat sees no DTD, no entity declaration and no external
+    reference: an entity other than the five predefined ones is an expat error) and is at most
+    ``FAST_PARSE_MAX_CHARS`` long; its tree is checked against ``MAX_DEPTH``. Any failure
+    (malformed XML, an undeclared prefix, a tree too deep) and every other text go through
+    :func:`parse`, which gives the same tree or the same error as before.
+    """
+    if len(text) <= FAST_PARSE_MAX_CHARS and "<!DOCTYPE" not in text:
+        try:
+            parser = XMLParser(target=TreeBuilder())
+            parser.feed(text)
+            root = parser.close()
+        except Exception:  # the checked parser below says what is wrong
+            root = None
+        if root is not None and _depth_within(root, MAX_DEPTH):
+            _strip_default_namespace(root)
+            return root, _LazyLines(text, name, root)
+    return parse(text, name)
+
+
+def _depth_within(root, depth: int) -> bool:
+    """Whether no element lies deeper than ``depth`` levels (the root is level 1)."""
+    level = [root]
+    for _ in range(depth):
+        level = [c for e in level for c in e]
+        if not level:
+            return True
+    return False
+
+
+class _LazyLines:
+    """``{id(element): line}`` of a tree parsed without lines, found on the first ``get`` by
+    parsing the text again with :func:`parse` (the two trees hold the same elements in the same
+    document order)."""
+
+    __slots__ = ("_text", "_name", "_root", "_lines")
+
+    def __init__(self, text: str, name: str, root):
+        self._text, self._name, self._root, self._lines = text, name, root, None
+
+    def get(self, key, default=None):
+        if self._lines is None:
+            root, lines = parse(self._text, self._name)
+            self._lines = {id(a): lines[id(b)] for a, b in zip(self._root.iter(), root.iter())}
+            self._text = self._root = None
+        return self._lines.get(key, default)
 
 
 class _UnboundPrefix(Exception):

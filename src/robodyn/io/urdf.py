@@ -37,10 +37,10 @@ from collections import Counter
 
 import numpy as np
 
-from ..builder import ModelBuilder, rpy_to_matrix
+from ..builder import ModelBuilder
 from ..errors import ModelError, RobodynWarning
 from ..model import Model
-from ._xml import MAX_DEPTH, is_xml_text, parse, read_source
+from ._xml import MAX_DEPTH, is_xml_text, parse, parse_lazy_lines, read_source
 
 # ``is_xml_text(source)``: whether a source is XML text rather than a path (relative mesh
 # paths of a file start at its folder), shared with the readers of the geometry.
@@ -85,8 +85,8 @@ def _read_transmission(rd: "_Reader", elem) -> dict[str, float]:
             raise ModelError(f"{rd.where(elem)}: a transmission with drake:rotor_inertia needs one named <joint>, "
                              f"got {joints}")
         ratio = _drake(act, "gear_ratio")
-        gear = rd.floats(ratio, "value", 1)[0] if ratio is not None else 1.0
-        out[joints[0]] = out.get(joints[0], 0.0) + rd.floats(rotor, "value", 1)[0] * gear * gear
+        gear = rd.value(ratio, "value") if ratio is not None else 1.0
+        out[joints[0]] = out.get(joints[0], 0.0) + rd.value(rotor, "value") * gear * gear
     return out
 
 
@@ -98,37 +98,96 @@ def _child(elem, tag: str):
     return None
 
 
+_ZEROS = (0.0, 0.0, 0.0)
+
+
+class _Where:
+    """``reader.where(elem, what)``, made when a message needs it (its line number is found
+    then: :func:`._xml.parse_lazy_lines`)."""
+
+    __slots__ = ("reader", "elem", "what")
+
+    def __init__(self, reader: "_Reader", elem, what: str | None = None):
+        self.reader, self.elem, self.what = reader, elem, what
+
+    def __str__(self) -> str:
+        return self.reader.where(self.elem, self.what)
+
+
 class _Reader:
-    def __init__(self, name: str, lines: dict[int, int]):
+    def __init__(self, name: str, lines):
         self.name = name
         self.lines = lines
+        self._parsed: dict[str, tuple] = {}  # attribute text -> its finite numbers ("0 0 0" recurs)
 
     def where(self, elem, what: str | None = None) -> str:
         label = what or f"<{elem.tag}" + (f" name={elem.get('name')!r}" if elem.get("name") is not None else "") + ">"
         return f"{self.name}: {label} (line {self.lines.get(id(elem), '?')})"
 
-    def floats(self, elem, attr: str, n: int, default=None) -> np.ndarray:
+    def values(self, elem, attr: str, n: int, default: tuple | None = None) -> tuple:
+        """The ``n`` finite numbers of attribute ``attr`` of ``elem`` (floats), or ``default``
+        (floats) when it is absent."""
         raw = None if elem is None else elem.get(attr)
         if raw is None:
             if default is None:
                 raise ModelError(f"{self.where(elem)}: missing attribute {attr!r}")
-            return np.asarray(default, dtype=float)
+            return default
+        vals = self._parsed.get(raw)
+        if vals is not None and len(vals) == n:
+            return vals
+        parts = raw.split()
+        if len(parts) == n:
+            try:
+                vals = tuple(map(float, parts))
+            except ValueError:
+                pass
+            else:
+                total = sum(vals)
+                if total - total == 0.0:  # all finite (else, or on an overflow, the checks below)
+                    self._parsed[raw] = vals
+                    return vals
         try:
-            vals = [float(t) for t in raw.split()]
+            vals = tuple([float(t) for t in parts])
         except ValueError:
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} is not {n} number(s)") from None
         if len(vals) != n:
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} needs {n} number(s)")
         if not all(map(math.isfinite, vals)):
             raise ModelError(f"{self.where(elem)}: attribute {attr}={raw!r} is not finite")
-        return np.array(vals)
+        return vals
+
+    def value(self, elem, attr: str, default: float | None = None) -> float:
+        """The one number of attribute ``attr`` (:meth:`values`)."""
+        raw = None if elem is None else elem.get(attr)
+        if raw is not None:
+            try:
+                x = float(raw)  # as float(raw.split()[0]) when it succeeds
+            except ValueError:
+                pass
+            else:
+                if x - x == 0.0:
+                    return x
+        return self.values(elem, attr, 1, None if default is None else (default,))[0]
+
+    def floats(self, elem, attr: str, n: int, default=None) -> np.ndarray:
+        """:meth:`values` as an array (``default`` any sequence)."""
+        return np.array(self.values(elem, attr, n, None if default is None else tuple(map(float, default))))
 
     def origin(self, parent):
         o = _child(parent, "origin")
         return self.floats(o, "xyz", 3, (0, 0, 0)), self.floats(o, "rpy", 3, (0, 0, 0))
 
-    def required_child(self, elem, tag: str, attr: str) -> str:
-        c = _child(elem, tag)
+    def origin_values(self, o) -> tuple[tuple, tuple]:
+        """``(xyz, rpy)`` of an ``<origin>`` element as float triples (zeros for None)."""
+        if o is None:
+            return _ZEROS, _ZEROS
+        return self.values(o, "xyz", 3, _ZEROS), self.values(o, "rpy", 3, _ZEROS)
+
+    def required_child(self, elem, tag: str, attr: str, c=False) -> str:
+        """Attribute ``attr`` of the first child ``<tag>`` of ``elem`` (or of ``c``, that child
+        or None, when given)."""
+        if c is False:
+            c = _child(elem, tag)
         if c is None or c.get(attr) is None:
             raise ModelError(f"{self.where(elem)}: missing <{tag} {attr}=...>")
         return c.get(attr)
@@ -150,7 +209,7 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     follow the order Pinocchio gives the same file.
     """
     text, name = _read_source(source)
-    root, lines = parse(text, name)
+    root, lines = parse_lazy_lines(text, name)
     rd = _Reader(name, lines)
     if root.tag != "robot":
         raise ModelError(f"{rd.where(root)}: root element must be <robot>, got <{root.tag}>")
@@ -176,9 +235,7 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     if _child(root, "link") is None:
         raise ModelError(f"{rd.where(root)}: no <link> element")
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
-        if _child(elem, "mimic") is not None:
-            mimic.append(elem.get("name"))
-        _read_joint(rd, b, elem, ignored, reversed_limits, armature.get(str(elem.get("name")), 0.0))
+        _read_joint(rd, b, elem, ignored, reversed_limits, mimic, armature.get(str(elem.get("name")), 0.0))
     if reversed_limits:
         warnings.warn(
             f"{name}: joint limits with lower > upper loaded as unbounded: {', '.join(reversed_limits)}",
@@ -197,29 +254,52 @@ def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
     lname = elem.get("name")
     if not lname:
         raise ModelError(f"{rd.where(elem)}: link without a name")
+    inertial, count = None, 0
     for child in elem:
-        if isinstance(child.tag, str) and child.tag != "inertial":
-            ignored[child.tag] += 1
-    inertials = [c for c in elem if c.tag == "inertial"]
-    if len(inertials) > 1:
+        tag = child.tag
+        if tag == "inertial":
+            inertial = inertial if count else child
+            count += 1
+        elif tag not in _LINK_IGNORED and isinstance(tag, str):  # visual and collision: never reported
+            ignored[tag] += 1
+    if count > 1:
         raise ModelError(f"{rd.where(elem)}: more than one <inertial>")
-    if not inertials:
-        b.add_link(lname, where=rd.where(elem))
+    if inertial is None:
+        b._add_link_values(lname, 0.0, _ZEROS, None, None, _Where(rd, elem))
         return
-    inertial = inertials[0]
-    where = rd.where(inertial, f"<link name={lname!r}> <inertial>")
-    xyz, rpy = rd.origin(inertial)
-    mass_el = _child(inertial, "mass")
+    where = _Where(rd, inertial, f"<link name={lname!r}> <inertial>")
+    origin = mass_el = I_el = None
+    for child in inertial:
+        tag = child.tag
+        if tag == "origin":
+            origin = origin if origin is not None else child
+        elif tag == "mass":
+            mass_el = mass_el if mass_el is not None else child
+        elif tag == "inertia":
+            I_el = I_el if I_el is not None else child
+    xyz, rpy = rd.origin_values(origin)
     if mass_el is None:
         raise ModelError(f"{where}: missing <mass value=...>")
-    mass = rd.floats(mass_el, "value", 1)[0]
-    I_el = _child(inertial, "inertia")
-    if I_el is None:
-        I = np.zeros((3, 3))
-    else:
-        ixx, ixy, ixz, iyy, iyz, izz = (rd.floats(I_el, k, 1, (0.0,))[0] for k in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz"))
-        I = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
-    b.add_link(lname, mass=mass, com=xyz, inertia=I, inertia_rotation=rpy_to_matrix(rpy), where=where)
+    mass = rd.value(mass_el, "value")
+    inertia = None if I_el is None else _inertia(rd, I_el)
+    # the inertia in axes turned by rpy_to_matrix(rpy), as add_link(inertia_rotation=...)
+    b._add_link_values(lname, mass, xyz, inertia, rpy, where)
+
+
+_INERTIA_ATTRS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+def _inertia(rd: _Reader, elem) -> tuple:
+    """``(ixx, ixy, ixz, iyy, iyz, izz)`` of an ``<inertia>`` (``rd.value`` of each, 0 when absent)."""
+    attrib = elem.attrib
+    try:  # all six given and finite: what rd.value gives
+        values = tuple([float(attrib[k]) for k in _INERTIA_ATTRS])
+        total = sum(values)
+        if total - total == 0.0:
+            return values
+    except (KeyError, ValueError):
+        pass
+    return tuple([rd.value(elem, k, 0.0) for k in _INERTIA_ATTRS])
 
 
 @dataclass(frozen=True, eq=False)
@@ -343,12 +423,19 @@ def _color(rd: _Reader, material) -> np.ndarray | None:
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 
 
-def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list,
+def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list, mimic: list,
                 armature: float = 0.0) -> None:
-    where = rd.where(elem)
+    where = _Where(rd, elem)
+    kids = {}  # the first child of each tag read
     for child in elem:
-        if isinstance(child.tag, str) and child.tag not in _JOINT_READ:
-            ignored[child.tag] += 1
+        tag = child.tag
+        if tag in _JOINT_READ:
+            if tag not in kids:
+                kids[tag] = child
+        elif isinstance(tag, str):
+            ignored[tag] += 1
+    if "mimic" in kids:
+        mimic.append(elem.get("name"))
     jname = elem.get("name")
     jtype = elem.get("type")
     if not jname:
@@ -357,32 +444,33 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
         raise ModelError(f"{where}: joint without a type")
     if jtype == "floating":
         jtype = "free"  # the builder checks that its parent link is welded to the world
-    parent = rd.required_child(elem, "parent", "link")
-    child = rd.required_child(elem, "child", "link")
-    xyz, rpy = rd.origin(elem)
-    axis = rd.floats(_child(elem, "axis"), "xyz", 3, (1.0, 0.0, 0.0))
-    if jtype == "planar" and not (np.linalg.norm(axis) > 0 and np.allclose(axis / np.linalg.norm(axis), (0, 0, 1),
-                                                                           rtol=0, atol=1e-12)):
-        raise ModelError(f"{where}: planar joint with axis {axis.tolist()}: only the joint frame's z axis is "
-                         "supported as the plane's normal (turn the joint's origin so that it is z)")
-    lim = _child(elem, "limit")
-    dyn = _child(elem, "dynamics")
+    parent = rd.required_child(elem, "parent", "link", kids.get("parent"))
+    child = rd.required_child(elem, "child", "link", kids.get("child"))
+    xyz, rpy = rd.origin_values(kids.get("origin"))
+    axis = rd.values(kids.get("axis"), "xyz", 3, (1.0, 0.0, 0.0))
+    if jtype == "planar":
+        a = np.array(axis)
+        if not (np.linalg.norm(a) > 0 and np.allclose(a / np.linalg.norm(a), (0, 0, 1), rtol=0, atol=1e-12)):
+            raise ModelError(f"{where}: planar joint with axis {a.tolist()}: only the joint frame's z axis is "
+                             "supported as the plane's normal (turn the joint's origin so that it is z)")
+    lim = kids.get("limit")
+    dyn = kids.get("dynamics")
     kw = {}
     if lim is not None:
         # URDF: lower and upper default to 0 in a <limit> (urdfdom and Pinocchio read it so);
         # without a <limit> element robodyn leaves the joint unbounded.
         for key in ("lower", "upper"):
-            kw[key] = _no_limit(rd.floats(lim, key, 1, (0.0,))[0])
+            kw[key] = _no_limit(rd.value(lim, key, 0.0))
         if kw["lower"] > kw["upper"] and jtype != "continuous":
             # PyBullet reads such a limit as no limit; robodyn does too, and says so
             reversed_limits.append(f"{jname} ({kw.pop('lower'):g} > {kw.pop('upper'):g})")
         for key in ("velocity", "effort"):
             if lim.get(key) is not None:
-                kw[key] = _no_limit(rd.floats(lim, key, 1)[0])
+                kw[key] = _no_limit(rd.value(lim, key))
     if dyn is not None:
         for key in ("damping", "friction"):
             if dyn.get(key) is not None:
-                kw[key] = rd.floats(dyn, key, 1)[0]
+                kw[key] = rd.value(dyn, key)
     if armature:
         kw["armature"] = armature
-    b.add_joint(jname, jtype, parent, child, xyz=xyz, rpy=rpy, axis=axis, where=where, **kw)
+    b._add_joint_values(jname, jtype, parent, child, xyz, rpy, axis, where, **kw)
