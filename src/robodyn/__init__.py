@@ -32,6 +32,7 @@ _LAZY = {
     "task_space_dynamics": "task_space", "TaskSpaceDynamics": "task_space",
     "regressor": "regressor", "kinetic_energy_regressor": "regressor", "potential_energy_regressor": "regressor",
     "slotine_li_regressor": "regressor", "rnea_derivatives": "rnea_derivatives",
+    "rnea_second_derivatives": "rnea_second_derivatives", "RNEASecondDerivatives": "rnea_second_derivatives",
     "aba_derivatives": "aba_derivatives", "mass_matrix_from_jacobians": "mass_jacobians",
     "inertia_bounds": "inertia_bounds",
 }
@@ -82,7 +83,8 @@ __all__ = [
     "dynamically_consistent_inverse", "task_space_dynamics", "TaskSpaceDynamics",
     "integrate", "difference", "simulate", "Trajectory", "simulation", "control", "plots",
     "regressor", "kinetic_energy_regressor", "potential_energy_regressor", "write_urdf", "write_mjcf",
-    "slotine_li_regressor", "interop", "rnea_derivatives", "aba_derivatives", "linearize",
+    "slotine_li_regressor", "interop", "rnea_derivatives", "rnea_second_derivatives", "RNEASecondDerivatives",
+    "aba_derivatives", "linearize",
     "integrate_jacobians", "difference_jacobians", "gravity_derivatives", "nonlinear_effects_derivatives",
     "generalized_momentum_derivatives", "frame_velocity_derivatives", "frame_acceleration_derivatives",
     "contact", "Contacts", "rollout", "Rollouts", "distributed", "simulate_many",

@@ -53,6 +53,7 @@ def _algorithm_steps(rd, model, q, v, a):
         ("hybrid_dynamics", lambda: rd.hybrid_dynamics(model, q, v, a, a, known)),
         ("inverse_mass_matrix", lambda: rd.inverse_mass_matrix(model, q)),
         ("rnea_derivatives", lambda: rd.rnea_derivatives(model, q, v, a)),
+        ("rnea_second_derivatives", lambda: rd.rnea_second_derivatives(model, q, v, a)),
         ("aba_derivatives", lambda: rd.aba_derivatives(model, q, v, a)),
         ("gravity_derivatives", lambda: rd.gravity_derivatives(model, q)),
         ("nonlinear_effects_derivatives", lambda: rd.nonlinear_effects_derivatives(model, q, v)),
@@ -105,14 +106,15 @@ def _public():
     from . import random
     from .algorithms import (aba, aba_derivatives, com, constrained, constrained_derivatives, coriolis, crba,
                              energy, frame_derivatives, hybrid, inertia_bounds, integrate, jacobian, kinematics,
-                             mass_jacobians, minv, regressor, rnea, rnea_derivatives, task_space, terms)
+                             mass_jacobians, minv, regressor, rnea, rnea_derivatives, rnea_second_derivatives,
+                             task_space, terms)
     from .simulation import rollout, simulate
 
     names = {}
     for module in (aba, aba_derivatives, com, constrained, constrained_derivatives, coriolis, crba, energy,
                    frame_derivatives, hybrid,
                    inertia_bounds, integrate, jacobian, kinematics, mass_jacobians, minv, regressor, rnea,
-                   rnea_derivatives, task_space, terms):
+                   rnea_derivatives, rnea_second_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module)
                       if not n.startswith("_") and not isinstance(getattr(module, n), ModuleType)})
     return SimpleNamespace(**names, simulate=simulate, rollout=rollout, random=random)
