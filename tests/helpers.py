@@ -366,3 +366,15 @@ def tangent_differences(fun, model, q, v, x, **kw):
     dv = richardson(lambda d: fun(model, q, v + d, x, **kw), model.nv)
     return dq, dv
 
+
+
+def check_wrench_batches(fn, model: rd.Model, frame: str, size: int, tol: float) -> None:
+    """``fn(model, Q, V, A, f_ext, frame)`` (a tuple of arrays) with wrenches per state
+    (B, nb, 6), one for all (nb, 6) or (1, nb, 6) equals its single-state calls."""
+    Q, V, A = states(model, "wrench-batch", size=size)
+    F = rng_for("wrench-batch", frame).standard_normal((size, model.nbodies, 6))
+    for wrenches, one in ((F, lambda s: F[s]), (F[0], lambda s: F[0]), (F[:1], lambda s: F[0])):
+        out = fn(model, Q, V, A, wrenches, frame)
+        for s in range(size):
+            for x, y in zip(out, fn(model, Q[s], V[s], A[s], one(s), frame)):
+                assert_rel(x[s], y, tol)

@@ -287,7 +287,7 @@ def test_bad_input():
         args[name][1] = np.nan
         with pytest.raises(ValueError, match=rf"constrained_dynamics_derivatives: {name} contains NaN or Inf"):
             call(model, args["q"], args["v"], args["tau"], [point])
-    with pytest.raises(ValueError, match=r"constraints\[1\]: constrained_dynamics_derivatives supports "
+    with pytest.raises(ValueError, match=r"constraints\[1\]: expected one of "
                                          r"\['PointConstraint', 'WeldConstraint', .*got str"):
         call(model, q, v, tau, [point, "contact"])
     with pytest.raises(ValueError, match="constraints: expected a sequence of constraints, got int"):

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 import robodyn as rd
-from helpers import (F_EXT_FRAMES, FD_TOL, G, assert_rel, check_batch, check_input_validation, fixed_base_models,
-                     input_checks, pendulum, random_models, rng_for, states, tangent_differences,
+from helpers import (F_EXT_FRAMES, FD_TOL, G, assert_rel, check_batch, check_input_validation, check_wrench_batches,
+                     fixed_base_models, input_checks, pendulum, random_models, rng_for, states, tangent_differences,
                      with_friction_and_armature)
 from robodyn.algorithms import rnea_derivatives as kernels
 from robodyn.random import random_model
@@ -132,14 +132,7 @@ def test_batch():
 @pytest.mark.parametrize("frame", F_EXT_FRAMES)
 def test_batch_of_wrenches(frame):
     """Wrenches per state (B, nb, 6), one for all (nb, 6) or (1, nb, 6)."""
-    model = random_model(5, seed=35, floating_base=True)
-    Q, V, A = states(model, "wrench-batch", size=4)
-    F = rng_for("wrench-batch", frame).standard_normal((4, model.nbodies, 6))
-    for wrenches, one in ((F, lambda s: F[s]), (F[0], lambda s: F[0]), (F[:1], lambda s: F[0])):
-        out = rd.rnea_derivatives(model, Q, V, A, wrenches, frame)
-        for s in range(4):
-            for x, y in zip(out, rd.rnea_derivatives(model, Q[s], V[s], A[s], one(s), frame)):
-                assert_rel(x[s], y, 1e-12)
+    check_wrench_batches(rd.rnea_derivatives, random_model(5, seed=35, floating_base=True), frame, 4, 1e-12)
 
 
 def check_paths(fun, packed):

@@ -18,7 +18,8 @@ import pytest
 
 import robodyn as rd
 from helpers import (F_EXT_FRAMES, FD_TOL, G, PLANAR_2R, assert_rel, check_batch, check_input_validation,
-                     fixed_base_models, input_checks, pendulum, planar_2r, random_models, richardson, rng_for, states)
+                     check_wrench_batches, fixed_base_models, input_checks, pendulum, planar_2r, random_models,
+                     richardson, rng_for, states)
 from robodyn import joints as J
 from robodyn.layout import MOTION
 from robodyn.random import random_model
@@ -254,14 +255,7 @@ def test_batch():
 @pytest.mark.parametrize("frame", F_EXT_FRAMES)
 def test_batch_of_wrenches(frame):
     """Wrenches per state (B, nb, 6), one for all (nb, 6) or (1, nb, 6)."""
-    model = random_model(3, seed=47, floating_base=True)
-    Q, V, A = states(model, "wrench-batch", size=3)
-    F = rng_for("wrench-batch", frame).standard_normal((3, model.nbodies, 6))
-    for wrenches, one in ((F, lambda s: F[s]), (F[0], lambda s: F[0]), (F[:1], lambda s: F[0])):
-        out = rd.rnea_second_derivatives(model, Q, V, A, wrenches, frame)
-        for s in range(3):
-            for x, y in zip(out, rd.rnea_second_derivatives(model, Q[s], V[s], A[s], one(s), frame)):
-                assert_rel(x[s], y, 1e-14)
+    check_wrench_batches(rd.rnea_second_derivatives, random_model(3, seed=47, floating_base=True), frame, 3, 1e-14)
 
 
 def test_result_type_and_shapes():

@@ -312,7 +312,9 @@ def constraint_jacobian(model, q, v, constraints: Sequence) -> tuple[np.ndarray,
     return tuple(np.concatenate([p[k] for p in parts], axis=1) for k in range(3))
 
 
-def _check_constraints(constraints) -> list:
+def check_constraints(constraints) -> list:
+    """``constraints`` (one constraint or a sequence) as a list, each one of
+    ``CONSTRAINT_TYPES``, or a ValueError naming the first that is not."""
     if isinstance(constraints, CONSTRAINT_TYPES):
         constraints = [constraints]
     try:
@@ -326,7 +328,8 @@ def _check_constraints(constraints) -> list:
     return out
 
 
-def _check_baumgarte(baumgarte) -> tuple[float, float]:
+def check_baumgarte(baumgarte) -> tuple[float, float]:
+    """``(alpha, beta)`` as finite floats >= 0, or a ValueError."""
     try:
         alpha, beta = (float(x) for x in baumgarte)
     except (TypeError, ValueError):
@@ -388,8 +391,8 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
     """
     if any_lazy(q, v, tau):
         return deferred(constrained_dynamics, locals())
-    constraints = _check_constraints(constraints)
-    alpha, beta = _check_baumgarte(baumgarte)
+    constraints = check_constraints(constraints)
+    alpha, beta = check_baumgarte(baumgarte)
     if not (np.isfinite(rcond) and 0 <= rcond < 1):
         raise ValueError(f"rcond: expected a number in [0, 1), got {rcond!r}")
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)

@@ -53,13 +53,12 @@ from scipy.spatial.transform import Rotation
 
 from ._lazy import any_lazy, deferred
 from . import _inputs
-from .constrained import (CONSTRAINT_TYPES, RCOND, CouplingConstraint, DistanceConstraint, LoopConstraint,
-                          PointConstraint, WeldConstraint, cholesky, constrained_dynamics, frame_kinematics)
+from .constrained import (RCOND, CouplingConstraint, LoopConstraint, PointConstraint,
+                          WeldConstraint, check_baumgarte, check_constraints, cholesky, constrained_dynamics,
+                          frame_kinematics)
 from .frame_derivatives import frame_acceleration_derivatives, frame_velocity_derivatives
 from .jacobian import moving_frame
 from .rnea_derivatives import rnea_derivatives
-
-SUPPORTED = (PointConstraint, WeldConstraint, LoopConstraint, DistanceConstraint, CouplingConstraint)
 
 
 class ConstrainedDynamicsDerivatives(NamedTuple):
@@ -177,30 +176,6 @@ def _rows(c, model, q, v, a, lam, alpha, beta):
     return J, cq, cv, [(pa, f, None), (pb, -f, None)], extra
 
 
-def _check_constraints(constraints) -> list:
-    if isinstance(constraints, CONSTRAINT_TYPES):
-        constraints = [constraints]
-    try:
-        out = list(constraints)
-    except TypeError:
-        raise ValueError(f"constraints: expected a sequence of constraints, got {type(constraints).__name__}") from None
-    for k, c in enumerate(out):
-        if not isinstance(c, SUPPORTED):
-            raise ValueError(f"constraints[{k}]: constrained_dynamics_derivatives supports "
-                             f"{[t.__name__ for t in SUPPORTED]}, got {type(c).__name__}")
-    return out
-
-
-def _check_baumgarte(baumgarte) -> tuple[float, float]:
-    try:
-        alpha, beta = (float(x) for x in baumgarte)
-    except (TypeError, ValueError):
-        raise ValueError(f"baumgarte: expected two numbers (alpha, beta), got {baumgarte!r}") from None
-    if not (np.isfinite(alpha) and np.isfinite(beta) and alpha >= 0 and beta >= 0):
-        raise ValueError(f"baumgarte: expected finite alpha >= 0 and beta >= 0, got {baumgarte!r}")
-    return alpha, beta
-
-
 def constrained_dynamics_derivatives(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
                                      rcond: float = RCOND, friction: bool = True, armature: bool = True,
                                      check_finite: bool = True) -> ConstrainedDynamicsDerivatives:
@@ -236,8 +211,8 @@ def constrained_dynamics_derivatives(model, q, v, tau, constraints, baumgarte=(0
     their derivatives, are not unique). Reference: Carpentier and Mansard, "Analytical
     derivatives of rigid body dynamics algorithms", RSS 2018.
     """
-    constraints = _check_constraints(constraints)
-    alpha, beta = _check_baumgarte(baumgarte)
+    constraints = check_constraints(constraints)
+    alpha, beta = check_baumgarte(baumgarte)
     if any_lazy(q, v, tau):
         return deferred(constrained_dynamics_derivatives, locals())
     what = "constrained_dynamics_derivatives"
