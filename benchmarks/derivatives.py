@@ -9,7 +9,9 @@ a Python loop over Pinocchio (which has no batched derivatives), each pair timed
 rounds, and ``aba_derivatives`` against central finite differences of ``aba`` (one
 batched ``aba`` call on the ``4 nv`` perturbed states, step 1e-6): time and accuracy. Every
 result is checked against Pinocchio (relative error printed). Ratio: robodyn / other, below 1
-robodyn is faster.
+robodyn is faster. ``rnea_second_derivatives`` against central differences of
+``rnea_derivatives`` (one batched call on the ``4 nv`` perturbed states, step 1e-6; Pinocchio's
+Python bindings do not expose its second-order derivatives): time and agreement.
 """
 
 from __future__ import annotations
@@ -44,6 +46,21 @@ def aba_by_differences(model, q, v, tau):
     return d[0].T, d[1].T
 
 
+def rnea_second_by_differences(model, q, v, a):
+    """``(d2tau_dq2, d2tau_dqdv, d2tau_dv2, d2tau_dadq)`` by central differences of
+    ``rnea_derivatives``: one batched call on the 4 nv perturbed states, ``[i, j, k]`` =
+    ``d/dx_k`` of ``dtau_i/dy_j``."""
+    n = model.nv
+    E = np.vstack([np.eye(n), -np.eye(n)]) * STEP
+    Q = np.vstack([rd.integrate(model, q, E), np.broadcast_to(q, (2 * n, q.size))])
+    V = np.vstack([np.broadcast_to(v, (2 * n, n)), v + E])
+    dq, dv, M = rd.rnea_derivatives(model, Q, V, np.broadcast_to(a, (4 * n, n)), friction=False)
+
+    def along(x, lo):  # stack the k-th difference last: (nv, nv, nv)
+        return np.moveaxis((x[lo:lo + n] - x[lo + n:lo + 2 * n]) / (2 * STEP), 0, -1)
+    return along(dq, 0), along(dq, 2 * n), along(dv, 2 * n), along(M, 0)
+
+
 def per_state(ours, n_ours: int, theirs, n_theirs: int) -> tuple[float, float]:
     """Microseconds per state of two batched calls, timed in alternating rounds (best of 15:
     a batch takes tens of milliseconds, and the host's speed drifts between seconds)."""
@@ -71,6 +88,9 @@ def section(name: str, relpath: str, floating: bool, batch: int) -> str:
     errors["aba_derivatives"] = max(rel_error(x, y) for x, y in zip(mine, theirs))
     fd = aba_by_differences(model, q, v, tau)
     errors["aba finite differences"] = max(rel_error(fd[0], mine[0]), rel_error(fd[1], mine[1]))
+    second = rd.rnea_second_derivatives(model, q, v, a, **kw)
+    errors["rnea second derivatives / differences"] = max(
+        rel_error(x, y) for x, y in zip(second, rnea_second_by_differences(model, q, v, a)))
     Bn = batch // 10  # the Python loops are slow: time them on a tenth of the batch
     rows = [
         Timing("rnea_derivatives", *paired_us(lambda: rd.rnea_derivatives(model, q, v, a, **kw),
@@ -85,12 +105,16 @@ def section(name: str, relpath: str, floating: bool, batch: int) -> str:
             lambda: [pin.computeABADerivatives(pm, data, *x) for x in zip(Q[:Bn], V[:Bn], T[:Bn])], Bn)),
         Timing("aba_derivatives / aba differences", *paired_us(lambda: rd.aba_derivatives(model, q, v, tau, **kw),
                                                                lambda: aba_by_differences(model, q, v, tau))),
+        Timing("rnea_second_derivatives / differences", *paired_us(
+            lambda: rd.rnea_second_derivatives(model, q, v, a, **kw),
+            lambda: rnea_second_by_differences(model, q, v, a))),
     ]
     head = (f"### {name} ({'floating' if floating else 'fixed'} base, nv = {model.nv}), Pinocchio {pin.__version__}, "
             f"{numba.get_num_threads()} threads, batch {batch}\n")
     agree = ", ".join(f"{k} {e:.1e}" for k, e in errors.items())
     return (head + "\n```\n" + format_table(rows, "other") + "\n```\n\n"
-            + f"Relative errors: against Pinocchio ({agree}; the last is the finite differences' error).\n")
+            + f"Relative errors: against Pinocchio ({agree}; the last two are the finite differences' "
+                     "errors).\n")
 
 
 def main() -> None:
