@@ -58,16 +58,16 @@ from __future__ import annotations
 from typing import NamedTuple
 
 import numpy as np
-from numba import prange
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import core, inline, kernel
 from ..spatial import force_act, inertia_act, inertia_matrix, motion_act
 from ..layout import (COULOMB, GRAVITY, INERTIA, INERTIA_END, IV, MOTION, NDOF, PARENT, SMOOTHING, STRIBECK,
                       STRIBECK_RATE)
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .kinematics import world_poses
-from .status import NONFINITE, raise_for_status, require_finite_result
+from .driver import batch_kernel, chunks
+from .status import NONFINITE, OK, raise_for_status, require_finite_result
 
 WHAT = "rnea_second_derivatives"
 Q_DIR, V_DIR, A_DIR = 0, 1, 2  # the kinds of directions
@@ -426,14 +426,23 @@ def _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, J, Y, W, fw, th, va
                 out[t_out, n, j, k] = val
 
 
-@parallel
-def _batch(tree, S, theta, oR, op, f, fcode, V, A, a0, out):
-    """:func:`_state` for every state ``s`` of the batch (first axis), in parallel; ``f`` (B or
-    1, nb, 6)."""
-    shared = f.shape[0] == 1
-    for s in prange(oR.shape[0]):
-        fs = np.int64(0) if shared else np.int64(s)  # (prange's index is unsigned)
-        _state(tree, S, theta, oR[s], op[s], f[fs], fcode, V[s], A[s], a0, out[s])
+@inline
+def _state_at(args, s, ws):
+    """:func:`_state` of state ``s`` of a batch (``f``: (B or 1, nb, 6)); :func:`_state`
+    allocates its own scratch (zeros on entry), ``ws`` is unused."""
+    parent, body_of, iv, nd, anc, S, theta, oR, op, f, fcode, V, A, a0, out = args  # flat: a parallel
+    tree = (parent, body_of, iv, nd, anc)                                           # loop takes no nested tuples
+    _state(tree, S, theta, oR[s], op[s], f[s if f.shape[0] > 1 else 0], fcode, V[s], A[s], a0, out[s])
+    return OK
+
+
+@kernel
+def _no_workspace(n):
+    """The driver's per-worker scratch: none needed here (see :func:`_state_at`)."""
+    return np.zeros(n)
+
+
+_batch = batch_kernel(_state_at, _no_workspace)
 
 
 # -- the Python layer: world quantities, directions, friction ------------------------------
@@ -540,7 +549,9 @@ def rnea_second_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *,
     if batch == ():  # one state: no threads to start
         _state(_tree(model), S, theta, oR, op, F, np.int64(fcode), V[0], A[0], a0, res[0])
     else:
-        _batch(_tree(model), S, theta, oR, op, F, np.int64(fcode), V, A, a0, res)
+        status = np.empty(B, dtype=np.int64)
+        _batch(_tree(model) + (S, theta, oR, op, F, np.int64(fcode), V, A, a0, res), (np.int64(1),), status,
+               chunks(B))
     out = [res[0, t] if batch == () else np.ascontiguousarray(res[:, t]) for t in range(4)]
     if friction and nv:
         with np.errstate(all="ignore"):  # NaN/Inf when check_finite=False: the check below says so
