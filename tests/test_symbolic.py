@@ -4,7 +4,6 @@ other, and the generated code (NumPy, Numba, C) against the numeric kernels."""
 from __future__ import annotations
 
 import ctypes
-import inspect
 import shutil
 import subprocess
 import sys
@@ -638,8 +637,6 @@ def test_dc_motor_plant_closed_forms():
     assert_rel(eom.to_function("M")(q), rd.crba(plant, q), 1e-10, "M")
 
 
-@pytest.mark.skipif("stribeck" not in inspect.signature(rd.Model).parameters,
-                    reason="the numeric model has no Stribeck friction")
 def test_stribeck_friction_is_reported_not_dropped_silently():
     from robodyn.errors import RobodynWarning
 

@@ -165,9 +165,9 @@ class FlexibleJoints(Controller):
         """The joint torque the motors apply to the links, ``K dz(theta - q) + D (theta' - v)``
         (the damping while the teeth touch)."""
         n = self.model.nv
-        x = z[:n] - q
-        touch = (np.abs(x) > self.backlash) | (self.backlash == 0)
-        return self.K * (x - np.clip(x, -self.backlash, self.backlash)) + self.D * (z[n:] - v) * touch
+        d = self.twist(q, z)
+        touch = (d != 0) | (self.backlash == 0)  # beyond the gap (everywhere without one)
+        return self.K * d + self.D * (z[n:] - v) * touch
 
     def torque(self, t, q, v, z):
         return self.spring(q, v, z)
