@@ -208,9 +208,8 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
             "which robodyn does not represent; build the Pinocchio model without mimic joints "
             "(buildModelFromUrdf(..., mimic=False)) and couple the joints with rd.CouplingConstraint")
     if kind == "JointModelUniversal":  # R = Rot(axis1, q1) Rot(axis2, q2): two revolute joints
-        jd = jm.createData()
-        jm.calc(jd, np.zeros(2))
-        return UNIVERSAL, np.asarray(jd.S, dtype=float)[3:].T.copy(), 0.0  # S at q = 0: [0; axis1], [0; axis2]
+        u = jm.extract()  # the JointModelUniversal itself (its data's S is not reliably filled by calc(q))
+        return UNIVERSAL, np.stack([np.asarray(u.axis1, dtype=float), np.asarray(u.axis2, dtype=float)]), 0.0
     if kind not in _FROM_PIN:
         raise ModelError(
             f"{source}: joint {name!r} is a {kind} ({jm.nq} q, {jm.nv} v), which robodyn cannot represent; "
