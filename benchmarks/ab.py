@@ -19,6 +19,7 @@ import subprocess
 import sys
 import tempfile
 import warnings
+from inspect import signature
 from pathlib import Path
 
 import numba
@@ -73,7 +74,9 @@ def main() -> None:
         relpath, floating = ROBOTS[name]
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            new, old = (lib.load_urdf(erd_urdf(relpath), floating_base=floating) for lib in (rd, ro))
+            new, old = (lib.load_urdf(erd_urdf(relpath), floating_base=floating,  # mimic joints independent
+                                      **({"mimic": "independent"} if "mimic" in signature(lib.load_urdf).parameters
+                                         else {})) for lib in (rd, ro))
         single, batch = states(new, args.batch)
         x = dict(zip("QVA", single if args.single else batch))
         per = 1 if args.single else args.batch

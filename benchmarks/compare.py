@@ -46,13 +46,14 @@ def erd_urdf(relpath: str) -> str:
 
 def load_pair(name: str, relpath: str, floating: bool):
     """robodyn's and Pinocchio's models of one example-robot-data URDF, ``(model, pin_model)``,
-    with the same configuration layout (a continuous joint would differ: refused)."""
+    with the same configuration layout (a continuous joint would differ: refused; mimic joints
+    as independent joints on both sides, Pinocchio's default)."""
     import pinocchio as pin
 
     f = erd_urdf(relpath)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        model = rd.load_urdf(f, floating_base=floating)
+        model = rd.load_urdf(f, floating_base=floating, mimic="independent")
     pm = pin.buildModelFromUrdf(f, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromUrdf(f)
     if pm.nq != model.nq:
         raise SystemExit(f"{name}: continuous joints make the q layouts differ; pick another robot")
@@ -128,7 +129,7 @@ def mujoco_section() -> str:
         f = erd_urdf(relpath)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            model = rd.load_urdf(f)
+            model = rd.load_urdf(f, mimic="independent")  # MuJoCo's <mimic>-free reading
         m = mujoco_model(f)
         d = mujoco.MjData(m)
         if m.nv != model.nv or m.nq != model.nq:

@@ -73,7 +73,7 @@ def main() -> None:
     if pm is not None:
         data = pm.createData()
         n = min(args.states, 2000)
-        urdf_model = rd.load_urdf(_panda_urdf(), physical="warn")
+        urdf_model = rd.load_urdf(_panda_urdf(), physical="warn", mimic="independent")  # as Pinocchio reads it
         qp, vp, ap = (rng.standard_normal((n, pm.nv)) for _ in range(3))
         t_pin = best_of(lambda: [pin.computeJointTorqueRegressor(pm, data, qp[i], vp[i], ap[i]) for i in range(n)], 3)
         t_rd = best_of(lambda: rd.regressor(urdf_model, qp, vp, ap), 3)

@@ -60,7 +60,7 @@ def floating_pair(path):
     pm = pin.buildModelFromUrdf(full, pin.JointModelFreeFlyer())
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
-        model = rd.load_urdf(full, floating_base=True, physical="warn")
+        model = rd.load_urdf(full, floating_base=True, physical="warn", mimic="independent")
     return model, pm
 
 

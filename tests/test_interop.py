@@ -45,7 +45,7 @@ CASES = [pytest.param(path, fb, id=f"{path.split('/')[-1]}-{'floating' if fb els
 def load_robodyn(path: str, floating_base: bool) -> rd.Model:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)  # ignored URDF elements
-        return rd.load_urdf(example_robot_data_dir() / path, floating_base=floating_base)
+        return rd.load_urdf(example_robot_data_dir() / path, floating_base=floating_base, mimic="independent")
 
 
 def load_pinocchio(path: str, floating_base: bool) -> pin.Model:

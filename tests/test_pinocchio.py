@@ -13,9 +13,10 @@ decides: its ABA leaves a non-finite D^-1 there and its mass matrix is singular,
 must refuse, naming that body.
 
 Joints are matched by name (robodyn keeps Pinocchio's order, which is asserted). Pinocchio
-stores a continuous joint as ``(cos, sin)``; robodyn as one angle. URDF ``<dynamics>``
-friction is ignored by Pinocchio's algorithms, so robodyn runs with ``friction=False``; the
-armature is zero on both sides.
+stores a continuous joint as ``(cos, sin)``; robodyn as one angle. Mimic joints are read as
+independent joints on both sides (Pinocchio's default; test_mimic.py compares the couplings).
+URDF ``<dynamics>`` friction is ignored by Pinocchio's algorithms, so robodyn runs with
+``friction=False``; the armature is zero on both sides.
 """
 
 from __future__ import annotations
@@ -75,7 +76,7 @@ def _pair(path, floating_base: bool):
         return e
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
-        model = rd.load_urdf(path, floating_base=floating_base, physical="warn")
+        model = rd.load_urdf(path, floating_base=floating_base, physical="warn", mimic="independent")
     return Pair(model, pm)
 
 

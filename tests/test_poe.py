@@ -71,7 +71,8 @@ def test_a_urdf_robot_from_twists():
     from conftest import example_robot_data_dir
 
     with pytest.warns(rd.RobodynWarning, match="mimic joints loaded as independent joints"):
-        model = rd.load_urdf(example_robot_data_dir() / "panda_description/urdf/panda.urdf").rigid()
+        model = rd.load_urdf(example_robot_data_dir() / "panda_description/urdf/panda.urdf",
+                             mimic="independent").rigid()
     twists, home, inertias, _ = poe_description(model)
     poe = rd.from_poe(twists, home, inertias, parents=model.parent, gravity=model.gravity)
     q, v, a = states(model, "poe-urdf", size=3)

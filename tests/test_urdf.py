@@ -197,10 +197,11 @@ def _pin_model(path: str, floating_base: bool) -> pin.Model:
 
 def _load_quietly(path, **kw) -> rd.Model:
     """Load, ignoring the RobodynWarnings about <gazebo>, <transmission>, ... and unphysical
-    links (their presence is asserted in the tests that are about them)."""
+    links (their presence is asserted in the tests that are about them); mimic joints as
+    independent joints, as Pinocchio's ``buildModelFromUrdf`` reads them by default."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
-        return rd.load_urdf(path, **kw)
+        return rd.load_urdf(path, **{"mimic": "independent", **kw})
 
 
 def _physical(path, floating_base: bool = False) -> str:
@@ -463,12 +464,17 @@ def test_root_element_must_be_robot():
         rd.load_urdf('<model name="r"><link name="a"/></model>')
 
 
-def test_mimic_joint_loads_as_independent_joint_with_warning(fixture_path):
+def test_mimic_joint_couples_by_default_and_loads_as_independent_joint_on_request(fixture_path):
     path = fixture_path("mimic.urdf")
+    model = rd.load_urdf(path)  # no warning: the coupling is read
+    assert isinstance(model, rd.CoupledModel) and model.nv == 1 and model.full.nv == 2
+    assert model.joint_names == ("left_joint",) and model.mimic == (("right_joint", "left_joint", 1.0, 0.0),)
     with pytest.warns(rd.RobodynWarning, match=r"mimic joints loaded as independent joints: \['right_joint'\]") as rec:
-        model = rd.load_urdf(path)
+        model = rd.load_urdf(path, mimic="independent")
     assert str(path) in str(rec[0].message)
     assert model.joint_names == ("left_joint", "right_joint") and model.nv == 2
+    with pytest.raises(ValueError, match="mimic must be 'couple' or 'independent'"):
+        rd.load_urdf(path, mimic="yes")
 
 
 def test_ignored_elements_warn(fixture_path):

@@ -212,7 +212,7 @@ def test_every_example_robot_written_loads_in_pinocchio():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", rd.RobodynWarning)
             try:
-                model = rd.load_urdf(path)
+                model = rd.load_urdf(path, mimic="independent")  # as Pinocchio reads the written file
             except rd.ModelError:
                 continue  # refused files are checked in test_urdf.py
             if model.nv == 0:
@@ -226,3 +226,10 @@ def test_every_example_robot_written_loads_in_pinocchio():
         assert_rel(np.triu(Mp) + np.triu(Mp, 1).T, rd.crba(model, q, armature=False)[np.ix_(pv, pv)], 1e-9, str(path))
         checked += 1
     assert checked >= 50, checked
+
+
+def test_friction_on_a_free_joint_is_reported_as_not_written():
+    model = random_model(3, seed=6, floating_base=True)
+    damped = model.replace(damping=np.r_[np.full(6, 0.5), np.zeros(model.nv - 6)])
+    with pytest.warns(rd.RobodynWarning, match="damping and friction of the free joint 'root_joint'; not written"):
+        rd.write_urdf(damped)

@@ -31,10 +31,11 @@ ROBOTS = {"panda": (ERD / "panda_description/urdf/panda.urdf", False),
 
 
 def quiet_load(source, floating_base=False):
-    """``load_urdf`` without its warning about what has no dynamics (materials, gazebo, ...)."""
+    """``load_urdf`` without its warning about what has no dynamics (materials, gazebo, ...);
+    mimic joints as independent joints, as Pinocchio's visual models read them."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RobodynWarning)
-        return rd.load_urdf(source, floating_base=floating_base)
+        return rd.load_urdf(source, floating_base=floating_base, mimic="independent")
 
 
 def load(name):

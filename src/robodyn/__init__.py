@@ -11,6 +11,7 @@ from .builder import ModelBuilder
 from .io import DHLink, dh_transform, from_dh, from_poe, load_mjcf, load_urdf, write_mjcf, write_urdf
 from .errors import ModelError, RobodynWarning
 from .model import Model
+from .coupling import CoupledModel
 from . import models, random
 
 # The algorithms are imported on first use (PEP 562), so that `import robodyn` stays fast.
@@ -72,8 +73,9 @@ def __dir__():
 __version__ = "0.1.0"
 
 __all__ = [
-    "Model", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh", "from_poe",
-    "load_urdf", "load_mjcf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects", "generalized_momentum",
+    "Model", "CoupledModel", "ModelError", "ModelBuilder", "RobodynWarning", "DHLink", "dh_transform", "from_dh",
+    "from_poe", "load_urdf", "load_mjcf", "models", "rnea", "aba", "crba", "gravity", "nonlinear_effects",
+    "generalized_momentum",
     "coriolis_matrix", "christoffel_symbols", "kinetic_energy", "potential_energy", "center_of_mass",
     "com_jacobian", "jacobian", "jacobian_dot_times_v", "forward_kinematics", "frame_pose", "warmup",
     "hybrid_dynamics", "inverse_mass_matrix", "constrained_dynamics", "ConstrainedDynamics", "PointConstraint",

@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import joints as J
+from .coupling import is_coupled, reduce_q
 from .model import Model, inertial_parameters_from
 
 
@@ -76,8 +77,11 @@ def random_model(nbodies: int, seed: int = 0, floating_base: bool = False, branc
 
 
 def random_configuration(model: Model, rng: np.random.Generator, size=()) -> np.ndarray:
-    """Random ``q`` (size + (nq,)): joints in [-pi, pi], positions in [-1, 1], unit quaternions."""
+    """Random ``q`` (size + (nq,)): joints in [-pi, pi], positions in [-1, 1], unit quaternions
+    (of a coupled model: the independent coordinates of its full tree's)."""
     size = (size,) if isinstance(size, int) else tuple(size)
+    if is_coupled(model):
+        return reduce_q(model, random_configuration(model.full, rng, size))
     q = rng.uniform(-np.pi, np.pi, size + (model.nq,))
     for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
         k, jt = model.idx_q[i], model.joint_type[i]

@@ -25,6 +25,8 @@ from numba import boolean
 
 from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..coupling import is_coupled
+from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from . import rnea as _rnea
@@ -160,6 +162,13 @@ def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, frict
         out = _rd.fast_path(_derivatives_packed, model, q, v, tau, friction, armature, check_finite)
         if out is not None:
             return out
+    if is_coupled(model):  # mimic joints: -M^-1 G^T (dtau_full) G at qdd, and M^-1
+        qdd, L = coupled.forward_dynamics(model, q, v, tau, f_ext, frame, friction, armature, check_finite,
+                                          "aba_derivatives")
+        dq, dv, _ = _rd.rnea_derivatives(model, q, v, qdd, f_ext, frame, friction=friction, armature=armature,
+                                         check_finite=check_finite)
+        Minv = coupled.solve(L, np.broadcast_to(np.eye(model.nv), L.shape))
+        return -Minv @ dq, -Minv @ dv, Minv
     k, nv = model.kernel, model.nv
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)

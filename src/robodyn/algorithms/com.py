@@ -14,6 +14,7 @@ import numpy as np
 
 from .._jit import core, inline, kernel
 from ..layout import IV, NDOF, PARENT
+from ..coupling import expand_q, is_coupled, reduce_columns
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -81,6 +82,9 @@ def _com_single(ints, body, dofs, q, check, c, Jc):
 
 
 def _run(model, q, check_finite, with_jacobian, what):
+    if is_coupled(model):  # the full tree's at E(q); the Jacobian J_full G
+        batch, C, JC = _run(model.full, expand_q(model, q), check_finite, with_jacobian, what)
+        return batch, C, reduce_columns(model, JC) if with_jacobian else JC
     if model.total_mass <= 0:
         raise ValueError(f"{what}: the model has no mass: its centre of mass is undefined")
     batch, x = _inputs.states(model, q=q)

@@ -33,6 +33,7 @@ import numpy as np
 
 from .. import joints as Jt
 from ..lie import skew
+from ..coupling import expand_q, is_coupled, reduce_columns
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .crba import crba
@@ -270,6 +271,9 @@ class CouplingConstraint:
         raise ValueError(f"CouplingConstraint: unknown 1-dof joint {name!r}; known: {list(model.joint_names)}")
 
     def rows(self, model, q, v):
+        if is_coupled(model):  # the full tree's row at E(q) (either joint may be a mimic joint), columns by G
+            J, dJv, phi = self.rows(model.full, expand_q(model, q), None)
+            return reduce_columns(model, J), dJv, phi
         (qa, va), (qb, vb) = self._indices(model, self.joint_a), self._indices(model, self.joint_b)
         q = _inputs.as_batch(q)
         J = np.zeros((q.shape[0], 1, model.nv))

@@ -27,6 +27,7 @@ from numba import boolean
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
+from ..coupling import expand_q, expand_v, into, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -178,15 +179,18 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray |
     float64 array to write into and return (see :func:`robodyn.rnea`). Reference: Echeandia
     and Wensing (2021).
     """
-    k = model.kernel  # fast path for one state: the kernel checks sizes and values
-    C = _inputs.fast_out(out, (model.nv, model.nv))
+    C = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks sizes and values
     try:
+        k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
         if _coriolis_packed(k.ints, k.packed[False, False], q, v, check_finite, C) == OK:
             return C
-    except TypeError:  # not contiguous float64 arrays
+    except (TypeError, AttributeError):  # not contiguous float64 arrays
         pass
     if any_lazy(q, v):
         return deferred(coriolis_matrix, locals())
+    if is_coupled(model):  # G^T C_full(E(q), G v) G
+        C = coriolis_matrix(model.full, expand_q(model, q), expand_v(model, v), check_finite=check_finite)
+        return into(out, reduce_matrix(model, C))
     batch, x = _inputs.states(model, q=q, v=v)
     return _run(model, batch, x, check_finite, "coriolis_matrix", out)[1]
 
@@ -203,6 +207,10 @@ def christoffel_symbols(model, q, *, check_finite: bool = True) -> np.ndarray:
     """
     if any_lazy(q):
         return deferred(christoffel_symbols, locals())
+    if is_coupled(model):  # Gamma_ijk = sum G_ai G_bj G_ck Gamma_full_abc
+        G = model.G
+        return np.einsum("...abc,ai,bj,ck->...ijk", christoffel_symbols(model.full, expand_q(model, q),
+                                                                          check_finite=check_finite), G, G, G)
     batch, x = _inputs.states(model, q=q)
     nv = model.nv
     Q = np.repeat(_inputs.as_batch(x["q"]), nv, axis=0)

@@ -19,6 +19,7 @@ from numba import boolean
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
+from ..coupling import expand_q, into, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -143,15 +144,18 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
-    k = model.kernel
     M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
+        k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
         if _crba_packed(k.ints, k.packed[False, armature], q, check_finite, M) == OK:
             return M
-    except (TypeError, KeyError):  # not contiguous float64 arrays (or armature not bool)
+    except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or armature not bool)
         pass
     if any_lazy(q):
         return deferred(crba, locals())
+    if is_coupled(model):  # G^T M_full G
+        M = crba(model.full, expand_q(model, q), armature=armature, check_finite=check_finite)
+        return into(out, reduce_matrix(model, M))
     batch, x = _inputs.states(model, q=q)
     dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)

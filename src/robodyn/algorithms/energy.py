@@ -14,6 +14,7 @@ import numpy as np
 from .._jit import core, inline, kernel
 from ..layout import INERTIA, INERTIA_END
 from ..spatial import dot6, inertia_mul
+from ..coupling import expand_q, expand_v
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -63,7 +64,11 @@ def _energy_single(ints, body, dofs, grav, q, v, check, out):
 
 def _run(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
-    k = model.kernel
+    try:
+        k = model.kernel
+    except AttributeError:  # a CoupledModel (mimic joints): the energies of the full tree at (E(q), G v)
+        full = {name: expand_q(model, x) if name == "q" else expand_v(model, x, name) for name, x in arrays.items()}
+        return _run(model.full, check_finite, what, **full)
     Q = _inputs.as_batch(x["q"])
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]

@@ -31,6 +31,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..layout import NDOF
+from ..coupling import expand_q, expand_v, is_coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .jacobian import FRAMES, jacobian_pass, moving_frame
@@ -68,7 +69,13 @@ def _path_motions(model, J, v, a, b):
 
 def _world(model, x, b, what, check):
     """World ``(J, V, A, dV/dq, dA/dq, dA/dv, oR_b, op_b)`` of body ``b`` for the states ``x``
-    (flat batch; the Jacobian and the derivatives as columns, (B, nv, 6))."""
+    (flat batch; the Jacobian and the derivatives as columns, (B, nv, 6)). A coupled model
+    (mimic joints): the full tree's at ``(E(q), G v, G a)``, the columns mapped by ``G``."""
+    if is_coupled(model):
+        full = {"q": expand_q(model, x["q"]), **{k: expand_v(model, x[k], k) for k in ("v", "a") if k in x}}
+        Jc, V, A, dV, dAq, dAv, OR, OP = _world(model.full, full, b, what, check)
+        Jc, dV, dAq, dAv = (np.einsum("bkr,kc->bcr", m, model.G) for m in (Jc, dV, dAq, dAv))
+        return Jc, V, A, dV, dAq, dAv, OR, OP
     JJ, OR, OP, ACC, _ = jacobian_pass(model, x, b, check, what)
     q = _inputs.as_batch(x["q"])
     v = np.broadcast_to(_inputs.as_batch(x["v"]), (q.shape[0], model.nv))

@@ -28,6 +28,8 @@ import numpy as np
 from .._deprecated import renamed_keyword
 from .._jit import inline, kernel
 from .. import joints as J
+from ..coupling import is_coupled
+from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -63,7 +65,14 @@ def known_dofs(model, known_mask) -> np.ndarray:
         if not (np.issubdtype(mask.dtype, np.integer) and np.all((mask == 0) | (mask == 1))):
             raise ValueError(f"known_mask: expected booleans (or 0/1), got {mask.dtype} values {mask.tolist()}")
         mask = mask.astype(bool)
-    for i in model.kernel.multi_dof_bodies:
+    try:
+        multi = model.kernel.multi_dof_bodies
+    except AttributeError:  # a CoupledModel: its joints of several dofs are independent joints of its tree
+        full = np.zeros(model.full.nv, dtype=bool)
+        full[model.independent_v] = mask
+        known_dofs(model.full, full)
+        return np.ascontiguousarray(mask)
+    for i in multi:
         k, n = model.idx_v[i], int(J.NV[model.joint_type[i]])
         block = mask[k:k + n]
         if block.any() != block.all():
@@ -72,6 +81,26 @@ def known_dofs(model, known_mask) -> np.ndarray:
                 f"known_mask: the {n} entries {k}..{k + n - 1} of {kind} joint {model.body_joint_names[i]!r} must be "
                 f"all True (joint acceleration given) or all False (joint force given), got {block.tolist()}")
     return np.ascontiguousarray(mask)
+
+
+def _coupled(model, q, v, a_known, tau_known, known, f_ext, frame, friction, armature, check_finite):
+    """Hybrid dynamics of a coupled model (mimic joints) from its reduced ``M`` and ``h``
+    (``algorithms.coupled``): ``M_uu a_u = tau_u - h_u - M_uk a_k``, then ``tau = M a + h``."""
+    batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
+    u = ~known
+    a = np.where(known, x["a_known"], 0.0)
+    tau_given = np.where(known, 0.0, x["tau_known"])
+    if check_finite and not (np.isfinite(a).all() and np.isfinite(tau_given).all()):
+        raise ValueError("hybrid_dynamics: a_known (where known) or tau_known (where not) contains NaN or Inf")
+    M = coupled.mass_matrix(model, x["q"], armature, check_finite)
+    h = coupled.bias_forces(model, x["q"], x["v"], f_ext, frame, friction, armature, check_finite)
+    if u.any():
+        rhs = (tau_given - h - np.einsum("...ij,...j->...i", M, a))[..., u]
+        L = coupled.cholesky(M[..., u, :][..., :, u], model, "hybrid_dynamics")
+        a[..., u] = coupled.solve(np.broadcast_to(L, rhs.shape[:-1] + L.shape[-2:]), rhs)
+    tau = np.einsum("...ij,...j->...i", M, a) + h
+    tau[..., u] = tau_given[..., u]
+    return _inputs.unflatten(a, batch), _inputs.unflatten(tau, batch)
 
 
 def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, frame: str = "local", *,
@@ -107,15 +136,21 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, fra
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "hybrid_dynamics()")
     known = known_dofs(model, known_mask)
-    k = model.kernel
-    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     if f_ext is None and frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
         a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
-        if _hybrid_single(k.ints, k.body, dofs, params, q, v, a_known, tau_known, known, k.zero_wrench,
-                          -1, check_finite, a, tau) == OK:
-            return a, tau
+        try:
+            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+            if _hybrid_single(k.ints, k.body, k.dofs[(bool(friction), bool(armature))], k.params[True], q, v,
+                              a_known, tau_known, known, k.zero_wrench, -1, check_finite, a, tau) == OK:
+                return a, tau
+        except AttributeError:
+            pass
     if any_lazy(q, v, a_known, tau_known, f_ext):
         return deferred(hybrid_dynamics, locals())
+    if is_coupled(model):
+        return _coupled(model, q, v, a_known, tau_known, known, f_ext, frame, friction, armature, check_finite)
+    k = model.kernel
+    dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,

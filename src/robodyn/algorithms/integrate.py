@@ -23,6 +23,7 @@ import numpy as np
 
 from .. import joints as J
 from ..lie import exp_se3, inverse_adjoint, log_se3, quat_matrix, quat_mul, right_jacobian_se3
+from ..coupling import expand_q, expand_v, is_coupled, reduce_q
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import require_finite_result
@@ -96,6 +97,8 @@ def integrate(model, q, v, *, check_finite: bool = True) -> np.ndarray:
     """
     if any_lazy(q, v):
         return deferred(integrate, locals())
+    if is_coupled(model):  # the independent coordinates of E(q) (+) G v
+        return reduce_q(model, integrate(model.full, expand_q(model, q), expand_v(model, v), check_finite=check_finite))
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
     check_configurations(model, check_finite, "integrate", q=q, v=v)
@@ -123,6 +126,9 @@ def difference(model, q0, q1, *, check_finite: bool = True) -> np.ndarray:
     """
     if any_lazy(q0, q1):
         return deferred(difference, locals())
+    if is_coupled(model):  # a mimic dof's difference is its source's times the multiplier
+        d = difference(model.full, expand_q(model, q0), expand_q(model, q1), check_finite=check_finite)
+        return d[..., model.independent_v]
     return _difference(model, q0, q1, check_finite, "difference")
 
 
@@ -159,6 +165,9 @@ def integrate_jacobians(model, q, v, *, check_finite: bool = True) -> tuple[np.n
     """
     if any_lazy(q, v):
         return deferred(integrate_jacobians, locals())
+    if is_coupled(model):  # mimic dofs are scalar: their blocks are identities, the rest as the full tree's
+        return _independent_blocks(model, integrate_jacobians(model.full, expand_q(model, q), expand_v(model, v),
+                                                              check_finite=check_finite))
     batch, x = _inputs.states(model, q=q, v=v)
     q, v = x["q"], x["v"]
     check_configurations(model, check_finite, "integrate_jacobians", q=q, v=v)
@@ -183,6 +192,9 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
     """
     if any_lazy(q0, q1):
         return deferred(difference_jacobians, locals())
+    if is_coupled(model):
+        return _independent_blocks(model, difference_jacobians(model.full, expand_q(model, q0), expand_q(model, q1),
+                                                               check_finite=check_finite))
     d = _difference(model, q0, q1, check_finite, "difference_jacobians")
     J1 = np.broadcast_to(np.eye(model.nv), d.shape[:-1] + (model.nv, model.nv)).copy()
     J0 = -J1
@@ -192,6 +204,12 @@ def difference_jacobians(model, q0, q1, *, check_finite: bool = True) -> tuple[n
         J1[..., block, block] = np.linalg.inv(right_jacobian_se3(xi)[..., sel, :][..., sel])
         J0[..., block, block] = -np.linalg.inv(right_jacobian_se3(-xi)[..., sel, :][..., sel])
     return J0, J1
+
+
+def _independent_blocks(model, matrices):
+    """The rows and columns of the independent dofs of a coupled model's full-tree matrices."""
+    k = model.independent_v
+    return tuple(np.ascontiguousarray(m[..., k, :][..., :, k]) for m in matrices)
 
 
 def _as_configuration(model, name: str, a) -> np.ndarray:

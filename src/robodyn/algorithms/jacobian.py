@@ -21,6 +21,7 @@ import numpy as np
 from .._jit import core, inline, kernel
 from ..layout import IV, MOTION, NDOF, PARENT
 from ..spatial import motion_act
+from ..coupling import expand_q, expand_v, is_coupled, reduce_columns
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -80,7 +81,12 @@ def jacobian_pass(model, x, b, check, what):
     ``"v"``, see ``_inputs.states``) and body ``b``: flat-batch arrays ``(J, oR_b, op_b, acc_b,
     vel_b)`` of :func:`jacobian_one`: the world Jacobian (B, 6, nv), the body's world rotation
     (B, 3, 3) and position (B, 3), and (with ``"v"``) its body-frame acceleration at
-    ``qdd = 0`` without gravity and velocity (B, 6); errors name ``what``."""
+    ``qdd = 0`` without gravity and velocity (B, 6); errors name ``what``. For a coupled model
+    (mimic joints) the full tree's at ``(E(q), G v)``, the Jacobian ``J_full G``."""
+    if is_coupled(model):
+        full = {"q": expand_q(model, x["q"]), **({"v": expand_v(model, x["v"])} if "v" in x else {})}
+        JJ, OR, OP, ACC, VEL = jacobian_pass(model.full, full, b, check, what)
+        return reduce_columns(model, JJ), OR, OP, ACC, VEL
     k = model.kernel
     q = _inputs.as_batch(x["q"])
     v = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))

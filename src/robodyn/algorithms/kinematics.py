@@ -16,6 +16,7 @@ from .._jit import inline, kernel
 from ..layout import IQ, IV, JTYPE, MOTION, NDOF, PARENT, UNIT_AXIS
 from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
+from ..coupling import expand_q, is_coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -112,7 +113,10 @@ _fk_batch = batch_kernel(fk_at, workspace)
 
 
 def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
-    """World rotations (..., nb, 3, 3) and positions (..., nb, 3) of every body, flat batch."""
+    """World rotations (..., nb, 3, 3) and positions (..., nb, 3) of every body, flat batch
+    (of a coupled model: the full tree's at ``E(q)``)."""
+    if is_coupled(model):
+        return world_poses(model.full, expand_q(model, q), batch, check, what)
     ints, body = model.kernel.ints, model.kernel.body
     nb = model.nbodies
     if batch == ():

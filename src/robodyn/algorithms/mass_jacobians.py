@@ -16,6 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import inertia_about_origin
+from ..coupling import expand_q, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from .jacobian import jacobian
 
@@ -34,6 +35,9 @@ def mass_matrix_from_jacobians(model, q, *, armature: bool = True, check_finite:
     joints' ``armature`` on the diagonal (as :func:`robodyn.crba`)."""
     if any_lazy(q):
         return deferred(mass_matrix_from_jacobians, locals())
+    if is_coupled(model):  # G^T M_full G (the mimic joints' armature included)
+        return reduce_matrix(model, mass_matrix_from_jacobians(model.full, expand_q(model, q), armature=armature,
+                                                               check_finite=check_finite))
     q = np.asarray(q, dtype=float)
     M = 0.0
     for i in range(model.nbodies):

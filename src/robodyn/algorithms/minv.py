@@ -39,6 +39,8 @@ from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_
 from ..joint_kernels import local_placement
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
+from ..coupling import is_coupled
+from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
@@ -245,14 +247,21 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
     articulated inertia is singular (``M`` is then singular too). Reference: Carpentier and
     Mansard, RSS 2018 (Pinocchio's ``computeMinverse``); RBDA Table 7.1.
     """
-    k = model.kernel
-    dofs = k.dofs[(False, bool(armature))]
     if _inputs.vectors(q):
         Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
-        if _minv_single(k.ints, k.body, dofs, q, check_finite, Minv) == OK:
-            return Minv
+        try:
+            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+            if _minv_single(k.ints, k.body, k.dofs[(False, bool(armature))], q, check_finite, Minv) == OK:
+                return Minv
+        except AttributeError:
+            pass
     if any_lazy(q):
         return deferred(inverse_mass_matrix, locals())
+    if is_coupled(model):  # mimic joints: the inverse of G^T M_full G
+        L = coupled.cholesky(coupled.mass_matrix(model, q, armature, check_finite), model, "inverse_mass_matrix")
+        return coupled.solve(L, np.broadcast_to(np.eye(model.nv), L.shape))
+    k = model.kernel
+    dofs = k.dofs[(False, bool(armature))]
     batch, x = _inputs.states(model, q=q)
     q = x["q"]
     if batch == ():

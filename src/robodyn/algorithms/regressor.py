@@ -52,6 +52,7 @@ from .._deprecated import renamed_keywords
 from .._jit import core, inline, kernel
 from ..layout import IQ, IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
+from ..coupling import expand_q, expand_v, is_coupled, reduce_rows
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -308,8 +309,9 @@ def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
 @renamed_keywords(viscous="damping")
 def extra_columns(model, *, damping: bool = False, coulomb: bool = False, stiffness: bool = False,
                   armature: bool = False, offset: bool = False) -> list[str]:
-    """Names of the extra regressor columns, in order: ``"damping[joint]"``, ... one per dof."""
-    names = model.dof_names
+    """Names of the extra regressor columns, in order: ``"damping[joint]"``, ... one per dof
+    (of ``model.full`` for a coupled model)."""
+    names = (model.full if is_coupled(model) else model).dof_names
     flags = dict(damping=damping, coulomb=coulomb, stiffness=stiffness, armature=armature, offset=offset)
     return [f"{kind}[{n}]" for kind in EXTRA_COLUMNS if flags[kind] for n in names]
 
@@ -330,7 +332,11 @@ def extended_parameters(model, *, damping: bool = False, coulomb: bool = False, 
     torques ``-stiffness * spring_reference`` (:func:`spring_offset`: zero without springs),
     or an (nv,) array of joint torque offsets. With every block on and ``offset=True``,
     ``regressor(model, q, v, a, damping=True, coulomb=True, stiffness=True, armature=True,
-    offset=True) @ extended_parameters(...) == rnea(model, q, v, a)``."""
+    offset=True) @ extended_parameters(...) == rnea(model, q, v, a)``. For a coupled model
+    (mimic joints) the joint blocks are those of every joint of ``model.full``."""
+    if is_coupled(model):
+        return extended_parameters(model.full, damping=damping, coulomb=coulomb, stiffness=stiffness,
+                                   armature=armature, offset=offset)
     parts = [model.inertial_parameters()]
     for on, values in ((damping, model.damping), (coulomb, model.coulomb), (stiffness, model.stiffness),
                        (armature, model.armature)):
@@ -374,6 +380,10 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, s
     """
     if any_lazy(q, v, a):
         return deferred(regressor, locals())
+    if is_coupled(model):  # mimic joints: G^T Y_full(E(q), G v, G a); extra columns per dof of the full tree
+        return reduce_rows(model, regressor(model.full, expand_q(model, q), expand_v(model, v), expand_v(model, a, "a"),
+                                            damping=damping, coulomb=coulomb, stiffness=stiffness,
+                                            armature=armature, offset=offset, check_finite=check_finite))
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     k = model.kernel
     flags = [float(bool(f)) for f in (damping, coulomb, stiffness, armature, offset)]
@@ -434,6 +444,11 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
     """
     if any_lazy(q, v, v_ref, a_ref):
         return deferred(slotine_li_regressor, locals())
+    if is_coupled(model):  # as regressor()
+        full = (expand_v(model, v), expand_v(model, v_ref, "v_ref"), expand_v(model, a_ref, "a_ref"))
+        return reduce_rows(model, slotine_li_regressor(model.full, expand_q(model, q), *full, damping=damping,
+                                                       coulomb=coulomb, stiffness=stiffness, armature=armature,
+                                                       offset=offset, check_finite=check_finite))
     batch, x = _inputs.states(model, q=q, v=v, v_ref=v_ref, a_ref=a_ref)
     k = model.kernel
     flags = [float(bool(f)) for f in (damping, coulomb, stiffness, armature, offset)]
@@ -453,6 +468,9 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
 
 
 def _energy(model, check_finite, what, **arrays):
+    if is_coupled(model):  # the full tree's at (E(q), G v)
+        full = {name: expand_q(model, x) if name == "q" else expand_v(model, x, name) for name, x in arrays.items()}
+        return _energy(model.full, check_finite, what, **full)
     batch, x = _inputs.states(model, **arrays)
     k = model.kernel
     Q = _inputs.as_batch(x["q"])

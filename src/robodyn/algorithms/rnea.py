@@ -25,6 +25,7 @@ from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOT
 from ..joint_kernels import body_placement, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
+from ..coupling import expand_q, expand_v, into, is_coupled, reduce_force
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
@@ -264,15 +265,19 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea()")
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
-        k = model.kernel  # fast path for one state: the kernel checks sizes and values
-        tau = _inputs.fast_out(out, (model.nv,))
+        tau = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks sizes and values
         try:
+            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
             if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
-        except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
+        except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
     if any_lazy(q, v, a, f_ext):
         return deferred(rnea, locals())
+    if is_coupled(model):  # tau = G^T tau_full(E(q), G v, G a)
+        tau = rnea(model.full, expand_q(model, q), expand_v(model, v), expand_v(model, a, "a"), f_ext, frame,
+                   friction=friction, armature=armature, check_finite=check_finite)
+        return into(out, reduce_force(model, tau))
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)

@@ -59,6 +59,7 @@ from ..joint_kernels import passive_torque_dv
 from ..layout import ARMATURE, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
                        motion_cross, wrench_to_local)
+from ..coupling import expand_q, expand_v, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from ._inputs import fits, nq_of, unpack
@@ -363,13 +364,14 @@ def _derivatives_packed(ints, packed, q, v, a, check, dq, dv, M):
 def fast_path(packed, model, q, v, x, friction, armature, check):
     """The three (nv, nv) results of the fast-path kernel ``packed`` (see ``_jit.fast``) for one
     state without external wrenches, or None when it does not take the arguments (then the
-    general path checks them and says what is wrong)."""
-    k, nv = model.kernel, model.nv
+    general path checks them and says what is wrong; a CoupledModel, which has no kernel)."""
+    nv = model.nv
     out = np.empty((nv, nv)), np.empty((nv, nv)), np.empty((nv, nv))
     try:
+        k = model.kernel
         if packed(k.ints, k.packed[friction, armature], q, v, x, check, *out) == OK:
             return out
-    except (TypeError, KeyError):  # not contiguous float64 arrays (or options not bool)
+    except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
         pass
     return None
 
@@ -404,6 +406,10 @@ def rnea_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *, fricti
         out = fast_path(_derivatives_packed, model, q, v, a, friction, armature, check_finite)
         if out is not None:
             return out
+    if is_coupled(model):  # mimic joints: G^T D_full G at (E(q), G v, G a)
+        full = rnea_derivatives(model.full, expand_q(model, q), expand_v(model, v), expand_v(model, a, "a"), f_ext,
+                                frame, friction=friction, armature=armature, check_finite=check_finite)
+        return tuple(reduce_matrix(model, D) for D in full)
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature)

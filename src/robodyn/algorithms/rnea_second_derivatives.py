@@ -63,6 +63,7 @@ from .._jit import core, inline, kernel
 from ..spatial import force_act, inertia_act, inertia_matrix, motion_act
 from ..layout import (COULOMB, GRAVITY, INERTIA, INERTIA_END, IV, MOTION, NDOF, PARENT, SMOOTHING, STRIBECK,
                       STRIBECK_RATE)
+from ..coupling import expand_q, expand_v, is_coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .kinematics import world_poses
@@ -532,6 +533,11 @@ def rnea_second_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *,
         raise ValueError(f"frame must be one of {sorted(_inputs.WRENCH_FRAMES)}, got {frame!r}")
     if any_lazy(q, v, a, f_ext):
         return deferred(rnea_second_derivatives, locals())
+    if is_coupled(model):  # mimic joints: T_ijk = sum G_ai G_bj G_ck T_full_abc at (E(q), G v, G a)
+        full = rnea_second_derivatives(model.full, expand_q(model, q), expand_v(model, v), expand_v(model, a, "a"),
+                                       f_ext, frame, friction=friction, armature=armature, check_finite=check_finite)
+        G = model.G
+        return RNEASecondDerivatives(*(np.einsum("...abc,ai,bj,ck->...ijk", T, G, G, G) for T in full))
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     if check_finite:

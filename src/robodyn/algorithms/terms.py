@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..coupling import expand_q, expand_v, reduce_force, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .rnea import run as _rnea_run
@@ -22,11 +23,19 @@ from .rnea_derivatives import run as _derivatives_run
 def _rnea_term(model, what, check_finite, gravity, armature, given, roles, run=_rnea_run, **options):
     """``run`` (the RNEA, or its derivatives) without friction on the caller's arrays ``given``
     (by their names), with ``roles`` mapping the kernel's ``v``/``a`` to a given name (missing:
-    zeros)."""
+    zeros). For a coupled model (mimic joints), the full tree's terms mapped by ``G``: forces
+    ``G^T f``, matrices ``G^T D G`` (see ``robodyn.coupling``)."""
     batch, x = _inputs.states(model, **given)
+    try:
+        F, fcode = _inputs.body_wrenches(model, None, batch, "local")  # reads the kernel tables
+    except AttributeError:  # a CoupledModel, which has none
+        full = {name: expand_q(model, x) if name == "q" else expand_v(model, x, name) for name, x in given.items()}
+        result = _rnea_term(model.full, what, check_finite, gravity, armature, full, roles, run, **options)
+        if run is _rnea_run:
+            return reduce_force(model, result)
+        return tuple(reduce_matrix(model, D) if D.shape[-1] else D for D in result)  # (0, 0): not computed
     zeros = np.zeros(model.nv) if batch == () else np.zeros((x["q"].shape[0], model.nv))
     kin = {"q": x["q"], **{role: x[name] if name else zeros for role, name in roles.items()}}
-    F, fcode = _inputs.body_wrenches(model, None, batch, "local")
     return run(model, batch, kin, F, fcode, check_finite, gravity=gravity, friction=False, armature=armature,
                what=what, report=x, **options)
 

@@ -10,11 +10,13 @@ import tempfile
 from pathlib import Path
 
 from .. import models
+from ..coupling import is_coupled
 
 
-def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
+def load_model(spec: str, floating_base: bool = False, physical: str = "error", mimic: str = "couple"):
     """A built-in robot by name, a MuJoCo model (``.xml``, ``.mjcf``) or a URDF file by path, or
-    a URDF of example-robot-data by its name (``solo12``) when that package is installed."""
+    a URDF of example-robot-data by its name (``solo12``) when that package is installed
+    (``mimic``: see :func:`robodyn.load_urdf`)."""
     from ..io.mjcf import load_mjcf
     from ..io.urdf import load_urdf
 
@@ -27,10 +29,10 @@ def load_model(spec: str, floating_base: bool = False, physical: str = "error"):
             raise ValueError("--floating-base applies to URDF files; a MuJoCo model declares its free joints")
         return load_mjcf(spec, physical=physical)
     if spec.endswith(".urdf") or "/" in spec:
-        return load_urdf(spec, floating_base=floating_base, physical=physical)
+        return load_urdf(spec, floating_base=floating_base, physical=physical, mimic=mimic)
     found = models.example_robot_urdf(spec)
     if found is not None:
-        return load_urdf(found, floating_base=floating_base, physical=physical)
+        return load_urdf(found, floating_base=floating_base, physical=physical, mimic=mimic)
     raise ValueError(f"unknown model {spec!r}: give a URDF or MJCF path, one of {models.names()}, or the name of "
                      f"a URDF of example-robot-data (pip install example-robot-data), e.g. solo12")
 
@@ -41,6 +43,27 @@ def add_model_arguments(p, default=None) -> None:
     p.add_argument("--floating-base", action="store_true", help="URDF: add a free-flying base")
     p.add_argument("--physical", choices=("error", "warn"), default="error",
                    help="reject (error) or keep with a warning (warn) unphysical inertias")
+    p.add_argument("--mimic", choices=("couple", "independent"), default="couple",
+                   help="URDF <mimic> joints: follow their source joint (couple) or move as independent joints")
+
+
+def loaded(args, command: str | None = None):
+    """The model of a command's arguments (:func:`add_model_arguments`); a ``command`` that does
+    not take mimic couplings refuses a model with them (:func:`refuse_couplings`)."""
+    if args.model is None:
+        raise ValueError(f"robodyn {args.command}: give a MODEL (built-in name, URDF or MJCF path)")
+    model = load_model(args.model, args.floating_base, args.physical, args.mimic)
+    if command is not None:
+        refuse_couplings(model, command)
+    return model
+
+
+def refuse_couplings(model, command: str) -> None:
+    """A clear error for a command that does not take mimic couplings."""
+    if is_coupled(model):
+        raise ValueError(f"{command}: {model.name!r} has mimic joints ({len(model.mimic)} coupled), which this "
+                         "command does not take; rerun with --mimic independent (the mimic joints as independent "
+                         "joints)")
 
 
 def check_output_file(path, option: str) -> None:

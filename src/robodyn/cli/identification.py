@@ -11,13 +11,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .common import add_model_arguments, check_output_dir, check_output_file, load_model, save, written
+from .common import add_model_arguments, check_output_dir, check_output_file, loaded, save, written
 
 
 def _model(args):
-    if args.model is None:
-        raise ValueError(f"robodyn {args.command}: give a MODEL (built-in name or URDF path)")
-    return load_model(args.model, args.floating_base, args.physical)
+    return loaded(args, args.command)
 
 
 def cmd_excite(args) -> int:

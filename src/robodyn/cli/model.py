@@ -8,7 +8,8 @@ import sys
 import numpy as np
 
 from .. import models
-from .common import add_model_arguments, load_model
+from ..coupling import independent_q, joint_tree
+from .common import add_model_arguments, loaded
 
 
 def _fmt(x, width=9, prec=4) -> str:
@@ -24,19 +25,22 @@ def cmd_info(args) -> int:
     if not args.model:
         print("robodyn info: give a MODEL (or --list)", file=sys.stderr)
         return 2
-    model = load_model(args.model, args.floating_base, args.physical)
+    model = loaded(args)
     print(model)
     print("\nInertial parameters per body (about the body origin, body frame):")
     print(f"  {'body':<24} {'m':>9} {'mcx':>9} {'mcy':>9} {'mcz':>9} {'Ixx':>9} {'Ixy':>9} {'Iyy':>9} {'Ixz':>9} {'Iyz':>9} {'Izz':>9}")
     for i, name in enumerate(model.link_names):
         print(f"  {name:<24} {_fmt(model.theta[i])}")
-    if model.nv:
+    tree = joint_tree(model)  # with mimic joints: every joint of the tree, the mimic joints marked
+    follows = {joint: f"= {r:g} {source}" + (f" {o:+g}" if o else "") for joint, source, r, o in getattr(model, "mimic", ())}
+    if tree.nv:
         print("\nJoint data (per velocity entry):")
-        print(f"  {'#':>3} {'lower':>9} {'upper':>9} {'vel.max':>9} {'effort':>9} {'damping':>9} {'coulomb':>9} {'armature':>9}")
-        for k in range(model.nv):
-            vals = [model.lower[k], model.upper[k], model.velocity_limit[k], model.effort_limit[k],
-                    model.damping[k], model.coulomb[k], model.armature[k]]
-            print(f"  {k:>3} {_fmt(vals)}")
+        print(f"  {'#':>3} {'lower':>9} {'upper':>9} {'vel.max':>9} {'effort':>9} {'damping':>9} {'coulomb':>9} "
+              f"{'armature':>9}  dof")
+        for k, name in enumerate(tree.dof_names):
+            vals = [tree.lower[k], tree.upper[k], tree.velocity_limit[k], tree.effort_limit[k],
+                    tree.damping[k], tree.coulomb[k], tree.armature[k]]
+            print(f"  {k:>3} {_fmt(vals)}  {name} {follows.get(name, '')}".rstrip())
     return 0
 
 
@@ -46,10 +50,12 @@ def sample_state(model, seed: int = 0):
     from ..random import random_configuration
 
     rng = np.random.default_rng(seed)
-    q = random_configuration(model, rng)
-    for i in range(model.nbodies):  # joint angles in [-pi/2, pi/2]; free and spherical joints as drawn
-        if NQ[model.joint_type[i]] == 1:
-            q[model.idx_q[i]] *= 0.5
+    tree = joint_tree(model)  # a model with mimic joints: its independent coordinates of the tree's
+    q = random_configuration(tree, rng)
+    for i in range(tree.nbodies):  # joint angles in [-pi/2, pi/2]; free and spherical joints as drawn
+        if NQ[tree.joint_type[i]] == 1:
+            q[tree.idx_q[i]] *= 0.5
+    q = independent_q(model, q)
     v = rng.uniform(-1.0, 1.0, model.nv)
     a = rng.uniform(-2.0, 2.0, model.nv)
     return q, v, a
@@ -58,7 +64,7 @@ def sample_state(model, seed: int = 0):
 def cmd_demo(args) -> int:
     import robodyn as rd
 
-    model = load_model(args.model, args.floating_base, args.physical)
+    model = loaded(args)
     q, v, a = sample_state(model, args.seed)
     np.set_printoptions(precision=4, suppress=True, linewidth=120)
     print(f"robodyn demo on {model.name!r}: nq={model.nq}, nv={model.nv}, {model.nbodies} bodies, "
@@ -78,7 +84,8 @@ def cmd_demo(args) -> int:
     residual = np.abs(inertial + coriolis + grav - tau).max()
     print(f"  max |M a + C v + g - rnea| = {residual:.2e}")
     extra = rd.rnea(model, q, v, a) - tau
-    if np.any(model.damping) or np.any(model.coulomb) or np.any(model.armature):
+    tree = joint_tree(model)
+    if np.any(tree.damping) or np.any(tree.coulomb) or np.any(tree.armature):
         print("  NOTE rnea(model, q, v, a) with its defaults also adds the joints' friction and rotor inertia\n"
               f"  (armature), up to {np.abs(extra).max():.4g} N m more: {rd.rnea(model, q, v, a)};\n"
               "  friction=False, armature=False (or model.rigid()) give the rigid-body terms above")
@@ -103,7 +110,7 @@ def cmd_demo(args) -> int:
 def cmd_bench(args) -> int:
     from ..bench import run_bench
 
-    model = load_model(args.model, args.floating_base, args.physical)
+    model = loaded(args, "bench")
     return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
 
 

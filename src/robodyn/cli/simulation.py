@@ -32,7 +32,8 @@ from collections import Counter
 import numpy as np
 
 from .. import models
-from .common import add_model_arguments, check_output_file, load_model, save, written
+from ..coupling import independent_q, joint_tree
+from .common import add_model_arguments, check_output_file, load_model, loaded, refuse_couplings, save, written
 
 CONTROLLERS = ("none", "pd-gravity", "computed-torque", "stand")
 
@@ -51,21 +52,24 @@ def _vector(text: str | None, n: int, name: str):
 
 def start_and_target(model, q0=None, target=None):
     """Default start (0, or mid-range outside the limits) and target (``q0 + 0.5`` inside the
-    limits) of the 1-dof joints; a floating base starts at the origin, upright."""
+    limits) of the 1-dof joints; a floating base starts at the origin, upright (a model with
+    mimic joints: the independent coordinates of its tree's start)."""
     from ..joints import FREE, PLANAR, SPHERICAL
 
     if q0 is None:
-        q0 = np.zeros(model.nq)
-        for i in range(model.nbodies):
-            k, kv = model.idx_q[i], model.idx_v[i]
-            if model.joint_type[i] == FREE:
+        tree = joint_tree(model)
+        q0 = np.zeros(tree.nq)
+        for i in range(tree.nbodies):
+            k, kv = tree.idx_q[i], tree.idx_v[i]
+            if tree.joint_type[i] == FREE:
                 q0[k + 6] = 1.0
-            elif model.joint_type[i] == SPHERICAL:
+            elif tree.joint_type[i] == SPHERICAL:
                 q0[k + 3] = 1.0
-            elif model.joint_type[i] == PLANAR:
+            elif tree.joint_type[i] == PLANAR:
                 q0[k + 2] = 1.0
-            elif not model.lower[kv] <= 0.0 <= model.upper[kv]:
-                q0[k] = 0.5 * (model.lower[kv] + model.upper[kv])
+            elif not tree.lower[kv] <= 0.0 <= tree.upper[kv]:
+                q0[k] = 0.5 * (tree.lower[kv] + tree.upper[kv])
+        q0 = independent_q(model, q0)
     if target is None and model.nq == model.nv:
         margin = 0.05 * np.where(np.isfinite(model.upper - model.lower), model.upper - model.lower, 0.0)
         lo, hi = model.lower + margin, model.upper - margin
@@ -178,7 +182,9 @@ def cmd_simulate(args) -> int:
     if args.controller is None:
         args.controller = "stand" if args.ground else "none"
     urdf = args.model not in models.names() and not args.model.lower().endswith((".xml", ".mjcf"))
-    model = load_model(args.model, args.floating_base or (args.ground and urdf), args.physical)
+    model = load_model(args.model, args.floating_base or (args.ground and urdf), args.physical, args.mimic)
+    if args.ground:
+        refuse_couplings(model, "simulate --ground")  # contacts do not combine with the couplings' constraints
     contacts = ground_contacts(model, args) if args.ground else None
     if args.contact_plot and contacts is None:
         raise ValueError("--contact-plot applies to --ground")
@@ -262,7 +268,7 @@ def cmd_torques(args) -> int:
     from ..io.log import read_trajectory
 
     check_output_file(args.plot, "--plot")
-    model = load_model(args.model, args.floating_base, args.physical)
+    model = loaded(args)
     t, q, v, a = read_trajectory(args.trajectory, model)
     data = save(lambda path: plot_torques(model, t, q, v, a, path), args.plot, "--plot")
     print(f"robodyn torques {model.name!r}: {t.shape[0]} samples from {args.trajectory}")

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 import time
 
-from .common import add_model_arguments, check_output_dir, check_output_file, load_model, save, written
+from .common import add_model_arguments, check_output_dir, check_output_file, loaded, save, written
 from ..files import write_text
 
 
@@ -44,7 +44,7 @@ def run_derive(model, args) -> int:
 def cmd_derive(args) -> int:
     check_output_file(args.latex, "--latex")
     check_output_dir(args.c_dir, "--c")
-    return run_derive(load_model(args.model, args.floating_base, args.physical), args)
+    return run_derive(loaded(args, "derive"), args)
 
 
 def add_commands(sub) -> None:

@@ -11,7 +11,7 @@ A URDF model is drawn with its ``<visual>`` geometry, any other as its capsule s
 from __future__ import annotations
 
 from .. import models
-from .common import add_model_arguments, check_output_file, load_model, save, written
+from .common import add_model_arguments, check_output_file, loaded, save, written
 
 
 def _extra(what: str):
@@ -38,7 +38,7 @@ def cmd_view(args) -> int:
     check_output_file(args.video, "--video")
     if args.video and not str(args.video).lower().endswith((".gif", ".mp4")):
         raise ValueError(f"--video {args.video}: expected a .gif or .mp4 file name")
-    model = load_model(args.model, args.floating_base, args.physical)
+    model = loaded(args)
     urdf = args.model not in models.names() and not args.model.lower().endswith((".xml", ".mjcf"))
     visuals = None
     if urdf:

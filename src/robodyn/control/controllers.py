@@ -32,6 +32,7 @@ import numpy as np
 
 from .._deprecated import renamed_attribute, renamed_keyword, renamed_keywords
 from .. import joints as J
+from ..coupling import is_coupled, joint_tree
 from ..algorithms.status import raise_for_status
 from ..algorithms.coriolis import coriolis_matrix
 from ..algorithms.crba import crba
@@ -160,18 +161,21 @@ class JointPD(Controller):
 
     def __init__(self, model, q_desired, kp, kd, tau_ff=None):
         self.model = model
-        free = [i for i in range(model.nbodies) if model.joint_type[i] == J.FREE]
-        if any(model.parent[i] >= 0 for i in free) or any(J.NV[model.joint_type[i]] != 1 for i in
-                                                           range(model.nbodies) if model.joint_type[i] != J.FREE):
+        tree = joint_tree(model)  # with mimic joints: the tree's joints, then the independent ones
+        free = [i for i in range(tree.nbodies) if tree.joint_type[i] == J.FREE]
+        if any(tree.parent[i] >= 0 for i in free) or any(J.NV[tree.joint_type[i]] != 1 for i in
+                                                          range(tree.nbodies) if tree.joint_type[i] != J.FREE):
             raise ValueError("JointPD: every joint but a root free joint must have one dof (revolute, prismatic, "
                              "helical)")
-        base = {k for i in free for k in range(model.idx_v[i], model.idx_v[i] + 6)}
-        self.actuated = np.array([k for k in range(model.nv) if k not in base], dtype=np.int64)
+        base = {k for i in free for k in range(tree.idx_v[i], tree.idx_v[i] + 6)}
+        dofs = model.independent_v if is_coupled(model) else np.arange(tree.nv)
+        coords = model.independent_q if is_coupled(model) else np.arange(tree.nq)
+        self.actuated = np.array([c for c, k in enumerate(dofs) if k not in base], dtype=np.int64)
         na = self.actuated.shape[0]
-        dof_body = np.empty(model.nv, dtype=np.int64)
-        for i in range(model.nbodies):
-            dof_body[model.idx_v[i]:model.idx_v[i] + J.NV[model.joint_type[i]]] = i
-        self.q_index = np.array([model.idx_q[dof_body[k]] for k in self.actuated], dtype=np.int64)
+        dof_body = np.empty(tree.nv, dtype=np.int64)
+        for i in range(tree.nbodies):
+            dof_body[tree.idx_v[i]:tree.idx_v[i] + J.NV[tree.joint_type[i]]] = i
+        self.q_index = np.searchsorted(coords, [tree.idx_q[dof_body[dofs[c]]] for c in self.actuated]).astype(np.int64)
         qd = np.array(q_desired, dtype=float)
         if qd.shape == (model.nq,):
             qd = qd[self.q_index]

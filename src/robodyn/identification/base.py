@@ -31,6 +31,7 @@ import numpy as np
 
 from .._deprecated import renamed_keywords
 from ..algorithms.regressor import EXTRA_COLUMNS, extra_columns, regressor
+from ..coupling import independent_q, joint_tree
 from ..joints import NQ
 from ..random import random_configuration
 from ._blas import one_blas_thread
@@ -48,16 +49,18 @@ def parameter_names(model, **extra) -> list[str]:
 
 def random_states(model, n: int, rng: np.random.Generator):
     """``n`` generic states: joint positions uniform within the limits (or in [-pi, pi]),
-    velocities and accelerations standard normal."""
-    q = random_configuration(model, rng, n)
-    for i in range(model.nbodies):
-        if NQ[model.joint_type[i]] > 1:  # free, spherical and planar joints stay as drawn
+    velocities and accelerations standard normal (a model with mimic joints: its independent
+    coordinates of the tree's)."""
+    tree = joint_tree(model)
+    q = random_configuration(tree, rng, n)
+    for i in range(tree.nbodies):
+        if NQ[tree.joint_type[i]] > 1:  # free, spherical and planar joints stay as drawn
             continue
-        k, kv = model.idx_q[i], model.idx_v[i]
-        lo, hi = model.lower[kv], model.upper[kv]
+        k, kv = tree.idx_q[i], tree.idx_v[i]
+        lo, hi = tree.lower[kv], tree.upper[kv]
         if np.isfinite(lo) and np.isfinite(hi) and hi > lo:
             q[:, k] = rng.uniform(lo, hi, n)
-    return q, rng.standard_normal((n, model.nv)), rng.standard_normal((n, model.nv))
+    return independent_q(model, q), rng.standard_normal((n, model.nv)), rng.standard_normal((n, model.nv))
 
 
 @dataclass(frozen=True)

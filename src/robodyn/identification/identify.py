@@ -21,6 +21,7 @@ import numpy as np
 
 from .._deprecated import renamed_keywords
 from ..algorithms.regressor import EXTRA_COLUMNS, extended_parameters
+from ..coupling import joint_tree
 from ..errors import ModelError, RobodynWarning
 from ..joints import NV
 from ._blas import one_blas_thread
@@ -69,9 +70,10 @@ class Identification:
 
     def extra(self) -> dict:
         """Identified per-dof extra parameters by kind (``damping``, ``coulomb``,
-        ``stiffness``, ``armature``, ``offset``), in the column order of the regressor."""
+        ``stiffness``, ``armature``, ``offset``), in the column order of the regressor (per dof
+        of every joint of the tree for a model with mimic joints)."""
         theta = self.standard_parameters()
-        out, col, nv = {}, 10 * self.model.nbodies, self.model.nv
+        out, col, nv = {}, 10 * self.model.nbodies, joint_tree(self.model).nv
         for kind in EXTRA_COLUMNS:
             if self.base.extra.get(kind, False):
                 out[kind] = theta[col:col + nv]
@@ -106,7 +108,7 @@ class Identification:
                                   f"{np.flatnonzero(values < 0).tolist()}: set to 0", RobodynWarning, stacklevel=2)
                 changes[kind] = np.maximum(values, 0.0)
         if "stiffness" in changes:
-            K, offset = changes["stiffness"], extra.get("offset", np.zeros(self.model.nv))
+            K, offset = changes["stiffness"], extra.get("offset", np.zeros(joint_tree(self.model).nv))
             sprung = K > 0
             changes["spring_reference"] = np.where(sprung, -offset / np.where(sprung, K, 1.0), 0.0)
         try:
@@ -132,8 +134,9 @@ class Identification:
         return "\n".join(lines)
 
     def _one_dof(self) -> np.ndarray:
-        """(nv,) whether each dof belongs to a joint of one dof (the joints that take springs)."""
-        m = self.model
+        """(nv,) whether each dof belongs to a joint of one dof (the joints that take springs); of
+        every joint of the tree for a model with mimic joints (the extra columns' dofs)."""
+        m = joint_tree(self.model)
         one = np.zeros(m.nv, dtype=bool)
         for i in range(m.nbodies):
             if NV[m.joint_type[i]] == 1:

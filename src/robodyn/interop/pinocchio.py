@@ -205,8 +205,9 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
         mimicked = [pm.names[m] for k, m in zip(pm.mimicking_joints, pm.mimicked_joints) if k == j]
         raise ModelError(
             f"{source}: joint {name!r} is a mimic joint (JointModelMimic of {', '.join(map(repr, mimicked))}), "
-            "which robodyn does not represent; build the Pinocchio model without mimic joints "
-            "(buildModelFromUrdf(..., mimic=False)) and couple the joints with rd.CouplingConstraint")
+            "which from_pinocchio does not convert; load the URDF with rd.load_urdf (a CoupledModel with the "
+            "same couplings), or build the Pinocchio model without mimic joints (buildModelFromUrdf(..., "
+            "mimic=False)) and couple the joints with rd.CouplingConstraint")
     if kind == "JointModelUniversal":  # R = Rot(axis1, q1) Rot(axis2, q2): two revolute joints
         u = jm.extract()  # the JointModelUniversal itself (its data's S is not reliably filled by calc(q))
         return UNIVERSAL, np.stack([np.asarray(u.axis1, dtype=float), np.asarray(u.axis2, dtype=float)]), 0.0

@@ -10,7 +10,10 @@ double, is no limit, as ``write_urdf`` writes it; a joint without ``<limit>`` is
 continuous joints always are), ``<dynamics damping friction>``, and a joint's armature from
 Drake's ``<transmission>`` extension (an ``<actuator>`` with ``<drake:rotor_inertia value>``
 and ``<drake:gear_ratio value>``: ``rotor_inertia * gear_ratio^2``; ``write_urdf`` writes it).
-``<mimic>`` joints load as independent joints with a warning. Elements without rigid-body
+A ``<mimic joint multiplier offset>`` joint follows its source joint, ``q = multiplier q_source +
+offset``: the model is then a :class:`~robodyn.coupling.CoupledModel` whose coordinates are the
+independent joints (``mimic="independent"`` loads mimic joints as ordinary joints, with a
+warning). Elements without rigid-body
 dynamics (material, gazebo, transmission, joint calibration and safety_controller, ...) are
 reported in one :class:`RobodynWarning` per file; link geometry (visual, collision) is not
 dynamics and is skipped without a warning (:func:`read_collisions` reads the collision
@@ -39,6 +42,7 @@ import numpy as np
 
 from ..builder import ModelBuilder
 from ..errors import ModelError, RobodynWarning
+from ..coupling import CoupledModel
 from ..model import Model
 from ._xml import MAX_DEPTH, is_xml_text, parse, parse_lazy_lines, read_source
 
@@ -196,7 +200,8 @@ class _Reader:
 _LINK_IGNORED = {"visual", "collision"}
 
 
-def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *, physical: str = "error") -> Model:
+def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *, physical: str = "error",
+              mimic: str = "couple") -> Model | CoupledModel:
     """Load a URDF file (path) or XML string into a :class:`Model`.
 
     ``floating_base=True`` adds a free joint at the root link (q gains 7 entries, v gains 6,
@@ -207,7 +212,14 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
 
     The children of a link are ordered by joint name (as urdfdom does), so bodies and ``v``
     follow the order Pinocchio gives the same file.
+
+    ``mimic="couple"`` (default): ``<mimic>`` joints are not degrees of freedom; a file with
+    any returns a :class:`~robodyn.coupling.CoupledModel` (``nv`` counts the independent
+    joints, as Pinocchio's ``buildModelFromUrdf(..., mimic=True)``). ``mimic="independent"``:
+    they load as ordinary joints (a :class:`Model`, as Pinocchio's default), with a warning.
     """
+    if mimic not in ("couple", "independent"):
+        raise ValueError(f"mimic must be 'couple' or 'independent', got {mimic!r}")
     text, name = _read_source(source)
     root, lines = parse_lazy_lines(text, name)
     rd = _Reader(name, lines)
@@ -215,7 +227,7 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
         raise ModelError(f"{rd.where(root)}: root element must be <robot>, got <{root.tag}>")
     b = ModelBuilder(root.get("name", "robot"), gravity=gravity, source=name, physical=physical)
     ignored: Counter[str] = Counter()
-    mimic, reversed_limits = [], []
+    mimics, reversed_limits = [], []
     joint_elems, armature = [], {}
     for elem in root:
         if not isinstance(elem.tag, str):
@@ -235,19 +247,30 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     if _child(root, "link") is None:
         raise ModelError(f"{rd.where(root)}: no <link> element")
     for elem in sorted(joint_elems, key=lambda e: str(e.get("name"))):
-        _read_joint(rd, b, elem, ignored, reversed_limits, mimic, armature.get(str(elem.get("name")), 0.0))
+        _read_joint(rd, b, elem, ignored, reversed_limits, mimics, armature.get(str(elem.get("name")), 0.0))
     if reversed_limits:
         warnings.warn(
             f"{name}: joint limits with lower > upper loaded as unbounded: {', '.join(reversed_limits)}",
             RobodynWarning, stacklevel=2,
         )
-    if mimic:
-        warnings.warn(f"{name}: mimic joints loaded as independent joints: {mimic}", RobodynWarning, stacklevel=2)
+    if mimics and mimic == "independent":
+        warnings.warn(f"{name}: mimic joints loaded as independent joints: {[m[0] for m in mimics]}", RobodynWarning,
+                      stacklevel=2)
     ignored_dyn = {k: v for k, v in ignored.items() if k not in _LINK_IGNORED}
     if ignored_dyn:
         summary = ", ".join(f"{n} <{k}>" for k, n in sorted(ignored_dyn.items()))
         warnings.warn(f"{name}: ignored elements without rigid-body dynamics: {summary}", RobodynWarning, stacklevel=2)
-    return b.build(floating_base=floating_base)
+    model = b.build(floating_base=floating_base)
+    if mimics and mimic == "couple":
+        moving = set(model.body_joint_names)
+        orphans = [m for m in mimics if m[1] not in moving]
+        if orphans:  # as Pinocchio's default reads them, rather than refusing the file
+            warnings.warn(f"{name}: mimic joints whose source is not a moving joint of the file, loaded as "
+                          f"independent joints: {', '.join(f'{j} (source {s!r})' for j, s, _, _ in orphans)}",
+                          RobodynWarning, stacklevel=2)
+        kept = [m for m in mimics if m[1] in moving]
+        return CoupledModel(model, kept) if kept else model
+    return model
 
 
 def _read_link(rd: _Reader, b: ModelBuilder, elem, ignored: Counter) -> None:
@@ -423,7 +446,7 @@ def _color(rd: _Reader, material) -> np.ndarray | None:
 _JOINT_READ = {"origin", "parent", "child", "axis", "limit", "dynamics", "mimic"}
 
 
-def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list, mimic: list,
+def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_limits: list, mimics: list,
                 armature: float = 0.0) -> None:
     where = _Where(rd, elem)
     kids = {}  # the first child of each tag read
@@ -434,8 +457,14 @@ def _read_joint(rd: _Reader, b: ModelBuilder, elem, ignored: Counter, reversed_l
                 kids[tag] = child
         elif isinstance(tag, str):
             ignored[tag] += 1
-    if "mimic" in kids:
-        mimic.append(elem.get("name"))
+    if "mimic" in kids and elem.get("type") == "fixed":
+        ignored["mimic"] += 1  # a fixed joint has nothing to couple (Pinocchio ignores it too)
+    elif "mimic" in kids:  # (joint, source, multiplier, offset)
+        m = kids["mimic"]
+        source = m.get("joint")
+        if not source:
+            raise ModelError(f"{rd.where(m)}: <mimic> without a joint attribute")
+        mimics.append((elem.get("name"), source, rd.value(m, "multiplier", 1.0), rd.value(m, "offset", 0.0)))
     jname = elem.get("name")
     jtype = elem.get("type")
     if not jname:

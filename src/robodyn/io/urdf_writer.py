@@ -32,6 +32,7 @@ import numpy as np
 
 from ..files import write_text
 from .. import joints as J
+from ..coupling import is_coupled
 from ..errors import RobodynWarning
 from ..model import mass_com_inertia
 from ._xml import numbers
@@ -88,7 +89,13 @@ def _finite(x: float) -> float:
 
 
 def write_urdf(model, path=None) -> str:
-    """The URDF text of ``model`` (module docstring); also written to ``path`` if given."""
+    """The URDF text of ``model`` (module docstring); also written to ``path`` if given. A model
+    with mimic joints (:class:`~robodyn.coupling.CoupledModel`) is written as its tree with a
+    ``<mimic>`` element on each mimic joint (following its independent source)."""
+    mimic = {}
+    if is_coupled(model):
+        mimic = {joint: (source, r, o) for joint, source, r, o in model.mimic}
+        model = model.full
     lost = []
     one_dof = J.NV[model.joint_type] == 1
     rotors = [(model.body_joint_names[i], model.armature[model.idx_v[i]]) for i in range(model.nbodies)
@@ -128,6 +135,10 @@ def write_urdf(model, path=None) -> str:
         if jt in (J.SPHERICAL, J.HELICAL):
             raise ValueError(f"write_urdf: joint {model.body_joint_names[i]!r} is {J.NAMES[jt]}, which URDF cannot "
                              "express")
+        if jt == J.FREE:
+            k = model.idx_v[i]
+            if np.any(model.damping[k:k + 6]) or np.any(model.coulomb[k:k + 6]):
+                lost.append(f"damping and friction of the free joint {model.body_joint_names[i]!r}")
         if jt == J.FREE and i == 0 and floating:
             continue
         if jt == J.PLANAR:
@@ -162,6 +173,9 @@ def write_urdf(model, path=None) -> str:
             lines.append(f"    <limit {attrs}/>")
         if model.damping[k] or model.coulomb[k]:
             lines.append(f'    <dynamics damping="{_num(model.damping[k])}" friction="{_num(model.coulomb[k])}"/>')
+        if model.body_joint_names[i] in mimic:
+            source, r, o = mimic[model.body_joint_names[i]]
+            lines.append(f'    <mimic joint={quoteattr(source)} multiplier="{_num(r)}" offset="{_num(o)}"/>')
         lines.append("  </joint>")
     for f in range(len(model.frame_names)):
         name, body = model.frame_names[f], int(model.frame_body[f])

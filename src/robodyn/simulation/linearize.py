@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import joints as J
+from ..coupling import expand_q, expand_v, is_coupled, joint_tree, reduce_q
 from ..algorithms.integrate import TWIST_COMPONENTS, check_configurations, joint_pose, joint_twist, set_joint_pose
 from ..lie import exp_se3, exp_so3, inverse_jacobian_coefficients, quat_matrix, quat_mul, right_jacobian_so3, skew
 from .simulate import INTEGRATORS
@@ -62,7 +63,13 @@ def _acceleration_derivatives(model, q, v, tau):
 
 def _chart(model, q0, theta, v):
     """``(q, k, Dq0, Dth, Kq, Kth, Kv)``: the point ``q = q0 ⊞ theta``, the chart's rate
-    ``k(q0, theta, v)`` and their Jacobians (see the module docstring), each (..., nv, nv)."""
+    ``k(q0, theta, v)`` and their Jacobians (see the module docstring), each (..., nv, nv).
+    A model with mimic joints (scalar joints, whose chart is ``q0 + theta``): the full tree's
+    chart at ``(E(q0), G theta, G v)`` on the independent coordinates."""
+    if is_coupled(model):
+        q, k, *D = _chart(model.full, expand_q(model, q0), expand_v(model, theta), expand_v(model, v))
+        iv = model.independent_v
+        return (reduce_q(model, q), k[..., iv], *(m[..., iv, :][..., :, iv] for m in D))
     n = model.nv
     eye = np.broadcast_to(np.eye(n), theta.shape[:-1] + (n, n))
     Dq0, Dth, Kv = eye.copy(), eye.copy(), eye.copy()
@@ -138,7 +145,8 @@ def linearize(model, q, v, tau, dt: float, integrator: str = "rk4") -> tuple[np.
         if x.ndim == 0 or x.shape[-1] != size:
             raise ValueError(f"{name}: expected shape (..., {size}), got {x.shape}")
         arrays[name] = x
-    check_configurations(model, True, "linearize", **arrays)
+    check_configurations(joint_tree(model), True, "linearize",
+                         **{**arrays, "q": expand_q(model, arrays["q"]) if is_coupled(model) else arrays["q"]})
     try:
         batch = np.broadcast_shapes(*(x.shape[:-1] for x in arrays.values()))
     except ValueError:

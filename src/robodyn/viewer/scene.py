@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..coupling import independent_q, joint_tree
 from ..errors import RobodynWarning
 from ..joints import PLANAR, QUAT_OFFSET
 from .geometry import Mesh, VisualShape, decimate, shape_mesh, skeleton, visuals as urdf_visuals
@@ -66,15 +67,17 @@ def parts(model, visuals=None, *, max_faces: int | None = None) -> list[Part]:
 
 
 def neutral_configuration(model) -> np.ndarray:
-    """``q`` (nq,) with every joint at zero: identity quaternions, planar angle 0."""
-    q = np.zeros(model.nq)
-    for i in range(model.nbodies):
-        k, jt = model.idx_q[i], model.joint_type[i]
+    """``q`` (nq,) with every joint at zero: identity quaternions, planar angle 0 (a model with
+    mimic joints: its independent coordinates)."""
+    tree = joint_tree(model)
+    q = np.zeros(tree.nq)
+    for i in range(tree.nbodies):
+        k, jt = tree.idx_q[i], tree.joint_type[i]
         if QUAT_OFFSET[jt] >= 0:
             q[k + QUAT_OFFSET[jt] + 3] = 1.0  # qw, scalar last
         elif jt == PLANAR:
             q[k + 2] = 1.0  # cos t
-    return q
+    return independent_q(model, q)
 
 
 @dataclass(frozen=True)
