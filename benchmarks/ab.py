@@ -28,7 +28,7 @@ import numpy as np
 ROBOTS = {"panda": ("panda_description/urdf/panda.urdf", False),
           "talos": ("talos_data/robots/talos_reduced.urdf", True)}
 ARGS = {"rnea": "QVA", "aba": "QVA", "crba": "Q", "coriolis_matrix": "QV", "inverse_mass_matrix": "Q",
-        "rnea_derivatives": "QVA", "aba_derivatives": "QVA"}
+        "rnea_derivatives": "QVA", "aba_derivatives": "QVA", "rnea_second_derivatives": "QVA"}
 
 
 def import_revision(rev: str):

@@ -196,9 +196,14 @@ def _state(tree, S, theta, oR, op, f, fcode, v, a, a0, out):
     ``f`` (nb, 6) in the frame of ``fcode`` (``_inputs.body_wrenches``; ignored for -1), ``v``,
     ``a`` and the base acceleration ``a0``; ``tree = (parent, body_of, iv, nd, anc)``.
     Allocates the workspace of :func:`_passes`."""
-    nb, nv = oR.shape[0], S.shape[0]
-    _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out,
-            np.zeros((nv, 6)), np.zeros((nb, 6, 6)), np.zeros((nb, 6)), np.zeros((nb, 3)), np.zeros(10),
+    _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, *_workspace(oR.shape[0], S.shape[0]))
+
+
+@kernel
+def _workspace(nb, nv):
+    """The scratch arrays of :func:`_passes`, zeros: one per state of :func:`_state`, one per
+    worker of the batch driver (which zeroes them again for every state: :func:`_state_at`)."""
+    return (np.zeros((nv, 6)), np.zeros((nb, 6, 6)), np.zeros((nb, 6)), np.zeros((nb, 3)), np.zeros(10),
             np.zeros((9, nb, 6)), np.zeros((nv, nb, 6, 6)), np.zeros((2, nv, nb, 6)), np.zeros((3 * nv, nv, 6)),
             np.zeros((5, 3 * nv, nb, 6)), np.zeros((nv, 6)), np.zeros((9, 6)), np.zeros((6, 6)))
 
@@ -429,21 +434,24 @@ def _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, J, Y, W, fw, th, va
 
 @inline
 def _state_at(args, s, ws):
-    """:func:`_state` of state ``s`` of a batch (``f``: (B or 1, nb, 6)); :func:`_state`
-    allocates its own scratch (zeros on entry), ``ws`` is unused."""
+    """:func:`_passes` of state ``s`` of a batch (``f``: (B or 1, nb, 6)) in the worker's
+    scratch ``ws`` (:func:`_workspace`; no allocation here, where reference counting is off)."""
     parent, body_of, iv, nd, anc, S, theta, oR, op, f, fcode, V, A, a0, out = args  # flat: a parallel
     tree = (parent, body_of, iv, nd, anc)                                           # loop takes no nested tuples
-    _state(tree, S, theta, oR[s], op[s], f[s if f.shape[0] > 1 else 0], fcode, V[s], A[s], a0, out[s])
+    J, Y, W, fw, th, values, LY, LYv, Jx, firsts, Jxy, small, X = ws
+    for x2 in (J, W, fw, Jxy, small, X):  # zeros on entry, as _passes needs them
+        _zero(x2)
+    for x3 in (Y, values, Jx):
+        _zero(x3)
+    for x4 in (LY, LYv, firsts):
+        _zero(x4)
+    _zero(th)
+    _passes(tree, S, theta, oR[s], op[s], f[s if f.shape[0] > 1 else 0], fcode, V[s], A[s], a0, out[s], J, Y, W,
+            fw, th, values, LY, LYv, Jx, firsts, Jxy, small, X)
     return OK
 
 
-@kernel
-def _no_workspace(n):
-    """The driver's per-worker scratch: none needed here (see :func:`_state_at`)."""
-    return np.zeros(n)
-
-
-_batch = batch_kernel(_state_at, _no_workspace)
+_batch = batch_kernel(_state_at, _workspace)
 
 
 # -- the Python layer: world quantities, directions, friction ------------------------------
@@ -556,7 +564,7 @@ def rnea_second_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *,
         _state(_tree(model), S, theta, oR, op, F, np.int64(fcode), V[0], A[0], a0, res[0])
     else:
         status = np.empty(B, dtype=np.int64)
-        _batch(_tree(model) + (S, theta, oR, op, F, np.int64(fcode), V, A, a0, res), (np.int64(1),), status,
+        _batch(_tree(model) + (S, theta, oR, op, F, np.int64(fcode), V, A, a0, res), (model.nbodies, nv), status,
                chunks(B))
     out = [res[0, t] if batch == () else np.ascontiguousarray(res[:, t]) for t in range(4)]
     if friction and nv:
