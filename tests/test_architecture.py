@@ -1,5 +1,7 @@
 """How the modules of ``src/robodyn`` may import each other (ARCHITECTURE.md): no import cycle,
-no private name from another file, private modules only inside their own package."""
+no private name from another file, private modules only inside their own package; and no
+module that defines a top-level function or class twice (the second silently replaces the
+first for every caller in the file)."""
 
 import ast
 import pathlib
@@ -85,6 +87,26 @@ def test_rules_catch_what_they_should(tmp_path, monkeypatch):
 @pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(PACKAGE)))
 def test_no_private_import_across_packages(path):
     assert violations(path) == []
+
+
+def redefinitions(path: pathlib.Path) -> list[str]:
+    """``name: lines`` of every top-level function or class defined more than once in the file."""
+    lines = {}
+    for node in ast.parse(path.read_text(), str(path)).body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            lines.setdefault(node.name, []).append(node.lineno)
+    return [f"{name}: lines {where}" for name, where in lines.items() if len(where) > 1]
+
+
+def test_redefinition_finder_finds_one(tmp_path):
+    path = tmp_path / "m.py"
+    path.write_text("def _zero(x):\n    pass\n\n\nclass A:\n    pass\n\n\ndef _zero(y):\n    pass\n")
+    assert redefinitions(path) == ["_zero: lines [1, 9]"]
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_no_top_level_name_defined_twice(path):
+    assert redefinitions(path) == []
 
 
 def import_graph(files):
