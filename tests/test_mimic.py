@@ -125,7 +125,8 @@ def test_forward_dynamics_is_the_full_tree_under_coupling_constraints(model, fra
     assert_rel(rd.rnea(model, q, v, a, f_ext, frame), tau, 1e-9, "rnea inverts aba")
     # and the reduced mass matrix is the constrained one: G^T M G, checked by its action
     M = rd.crba(model, q)
-    assert_rel(M, M.T, 1e-14) and np.all(np.linalg.eigvalsh(M) > 0)
+    assert_rel(M, M.T, 1e-14)
+    assert np.all(np.linalg.eigvalsh(M) > 0)
 
 
 @coupled_models
@@ -139,7 +140,8 @@ def test_hybrid_dynamics_of_a_coupled_model(model):
         if i % 2 and names:
             mask[[model.dof_names.index(n) for n in names]] = True
     a_h, tau_h = rd.hybrid_dynamics(model, q, v, a, tau, mask)
-    assert_rel(a_h[mask], a[mask], 0.0) and assert_rel(tau_h[~mask], tau[~mask], 0.0)
+    assert_rel(a_h[mask], a[mask], 0.0)
+    assert_rel(tau_h[~mask], tau[~mask], 0.0)
     assert_rel(rd.rnea(model, q, v, a_h), tau_h, 1e-9)
     assert_rel(rd.hybrid_dynamics(model, q, v, a, tau, np.ones(model.nv, bool))[1], rd.rnea(model, q, v, a), 1e-12)
     assert_rel(rd.hybrid_dynamics(model, q, v, a, tau, np.zeros(model.nv, bool))[0], rd.aba(model, q, v, tau), 1e-9)
@@ -178,9 +180,9 @@ def test_terms_and_energies(model):
     assert_rel(rd.mass_matrix_from_jacobians(model, q), M, 1e-9)
     assert_rel(rd.inverse_mass_matrix(model, q) @ M, np.eye(model.nv), 1e-9)
     # gravity is the gradient of the potential energy along the coupled motion
+    h_ = 1e-5
     dU = np.array([(rd.potential_energy(model, rd.integrate(model, q, h_ * e)) -
-                    rd.potential_energy(model, rd.integrate(model, q, -h_ * e))) / (2 * h_)
-                   for e in np.eye(model.nv) for h_ in (1e-5,)])
+                    rd.potential_energy(model, rd.integrate(model, q, -h_ * e))) / (2 * h_) for e in np.eye(model.nv)])
     assert_rel(dU, g, 1e-6, "dU/dq")
     C = rd.coriolis_matrix(model, q, v)
     assert_rel(C @ v, h - g, 1e-9)
@@ -198,18 +200,21 @@ def test_derivatives_by_differences(model):
     f_ext = rng_for(model.name, "wrench").standard_normal((model.nbodies, 6))
     dq, dv, da = rd.rnea_derivatives(model, q, v, a, f_ext)
     fq, fv = tangent_differences(lambda m, q_, v_, a_: rd.rnea(m, q_, v_, a_, f_ext), model, q, v, a)
-    assert_rel(dq, fq, 1e-6, "dtau/dq") and assert_rel(dv, fv, 1e-6, "dtau/dv")
+    assert_rel(dq, fq, 1e-6, "dtau/dq")
+    assert_rel(dv, fv, 1e-6, "dtau/dv")
     assert_rel(da, rd.crba(model, q), 1e-12)
     tau = rd.rnea(model, q, v, a)
     Aq, Av, Minv = rd.aba_derivatives(model, q, v, tau)
     fq, fv = tangent_differences(lambda m, q_, v_, t_: rd.aba(m, q_, v_, t_), model, q, v, tau)
-    assert_rel(Aq, fq, 1e-6, "da/dq") and assert_rel(Av, fv, 1e-6, "da/dv")
+    assert_rel(Aq, fq, 1e-6, "da/dq")
+    assert_rel(Av, fv, 1e-6, "da/dv")
     assert_rel(Minv, rd.inverse_mass_matrix(model, q), 1e-9)
     gq = rd.gravity_derivatives(model, q)
     assert_rel(gq, tangent_differences(lambda m, q_, v_, x: rd.gravity(m, q_), model, q, v, a)[0], 1e-6)
     nq, nv = rd.nonlinear_effects_derivatives(model, q, v)
     fq, fv = tangent_differences(lambda m, q_, v_, x: rd.nonlinear_effects(m, q_, v_), model, q, v, a)
-    assert_rel(nq, fq, 1e-6) and assert_rel(nv, fv, 1e-6)
+    assert_rel(nq, fq, 1e-6)
+    assert_rel(nv, fv, 1e-6)
     pq, pM = rd.generalized_momentum_derivatives(model, q, v)
     assert_rel(pq, tangent_differences(lambda m, q_, v_, x: rd.generalized_momentum(m, q_, v), model, q, v, a)[0],
                1e-6)
@@ -233,11 +238,14 @@ def test_kinematics_by_differences(model):
     assert_rel(rd.com_jacobian(model, q) @ v, (c1 - c0) / (2 * step), 1e-6, "centre of mass")
     dVq, dVv = rd.frame_velocity_derivatives(model, q, v, body)
     fq, fv = tangent_differences(lambda m, q_, v_, x: rd.jacobian(m, q_, body) @ v_, model, q, v, a)
-    assert_rel(dVq, fq, 1e-6) and assert_rel(dVv, fv, 1e-9)
+    assert_rel(dVq, fq, 1e-6)
+    assert_rel(dVv, fv, 1e-9)
     dAq, dAv, dAa = rd.frame_acceleration_derivatives(model, q, v, a, body)
     acc = lambda m, q_, v_, a_: rd.jacobian(m, q_, body) @ a_ + rd.jacobian_dot_times_v(m, q_, v_, body)  # noqa: E731
     fq, fv = tangent_differences(acc, model, q, v, a)
-    assert_rel(dAq, fq, 1e-6) and assert_rel(dAv, fv, 1e-6) and assert_rel(dAa, rd.jacobian(model, q, body), 1e-12)
+    assert_rel(dAq, fq, 1e-6)
+    assert_rel(dAv, fv, 1e-6)
+    assert_rel(dAa, rd.jacobian(model, q, body), 1e-12)
     # Jdot v by differences of J along the motion
     J1, J0 = (rd.jacobian(model, rd.integrate(model, q, s * v), body) for s in (step, -step))
     assert_rel(rd.jacobian_dot_times_v(model, q, v, body), (J1 - J0) / (2 * step) @ v, 1e-6, "Jdot v")
@@ -510,7 +518,8 @@ def test_simulation_is_the_coupled_models_own_integration():
     traj = rd.simulate(model, q0, v0, 0.1, 0.01, law, "rk4")
     assert traj.model is model and traj.q.shape == (11, model.nq) and traj.tau.shape == (11, model.nv)
     q, v = _reduced_rk4(model, q0, v0, 0.01, 10, law)
-    assert_rel(traj.q[-1], q, 1e-12) and assert_rel(traj.v[-1], v, 1e-12)
+    assert_rel(traj.q[-1], q, 1e-12)
+    assert_rel(traj.v[-1], v, 1e-12)
     assert_rel(traj.tau[3], np.clip(law(0.03, traj.q[3], traj.v[3]), -model.effort_limit, model.effort_limit), 1e-12)
     assert traj.lyapunov is not None and traj.q_desired.shape == traj.q.shape
     euler = rd.simulate(model, q0, v0, 0.05, 0.01, integrator="semi_implicit_euler")
@@ -518,7 +527,8 @@ def test_simulation_is_the_coupled_models_own_integration():
     for _ in range(5):
         v = v + 0.01 * rd.aba(model, q, v, np.zeros(model.nv))
         q = q + 0.01 * v
-    assert_rel(euler.q[-1], q, 1e-12) and assert_rel(euler.v[-1], v, 1e-12)
+    assert_rel(euler.q[-1], q, 1e-12)
+    assert_rel(euler.v[-1], v, 1e-12)
 
 
 def test_simulation_of_a_floating_coupled_model_conserves_energy():
@@ -601,7 +611,8 @@ def test_linearize_a_coupled_model_against_differences_of_simulate(index, integr
     A, B = rd.linearize(model, q, v, tau, DT, integrator)
     fd_A, fd_B = by_differences(model, q, v, tau, integrator)
     assert A.shape == (2 * model.nv, 2 * model.nv) and B.shape == (2 * model.nv, model.nv)
-    assert_rel(A, fd_A, TOL, "A") and assert_rel(B, fd_B, TOL, "B")
+    assert_rel(A, fd_A, TOL, "A")
+    assert_rel(B, fd_B, TOL, "B")
 
 
 def test_identification_of_a_coupled_model():

@@ -36,13 +36,7 @@ import numpy as np
 
 from . import joints as J
 from .errors import ModelError
-from .model import Model
-
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, copy=True)
-    a.flags.writeable = False
-    return a.view()
+from .model import Model, readonly
 
 
 class CoupledModel:
@@ -116,12 +110,12 @@ class CoupledModel:
         setattr_(self, "full", full)
         setattr_(self, "mimic", tuple((j, *resolved[j]) for j in rule))
         for key, a in (("G", G), ("P", P), ("offset", offset), ("independent_q", ind_q), ("independent_v", ind_v)):
-            setattr_(self, key, _readonly(a))
+            setattr_(self, key, readonly(a, a.dtype))
         setattr_(self, "nq", int(len(ind_q)))
         setattr_(self, "nv", int(len(ind_v)))
         setattr_(self, "joint_names", tuple(n for n in full.joint_names if n not in resolved))
         for key in ("lower", "upper", "velocity_limit", "effort_limit"):
-            setattr_(self, key, _readonly(getattr(full, key)[ind_v]))
+            setattr_(self, key, readonly(getattr(full, key)[ind_v]))
 
     def __setattr__(self, key, value):
         raise AttributeError("CoupledModel is immutable")

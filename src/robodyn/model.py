@@ -37,7 +37,7 @@ INERTIA_RTOL = 1e-6
 INERTIA_ATOL = 1e-12
 
 
-def _readonly(a, dtype=float):
+def readonly(a, dtype=float):
     """A read-only copy; returned as a view of a read-only base so that setting
     ``flags.writeable = True`` on it fails as well."""
     a = np.array(a, dtype=dtype, copy=True)
@@ -345,30 +345,30 @@ class Model:
             raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
         setattr_(self, "physical", physical)
         setattr_(self, "name", str(name))
-        setattr_(self, "parent", _readonly(parent, np.int64))
-        setattr_(self, "joint_type", _readonly(jt, np.int64))
-        setattr_(self, "joint_axis", _readonly(axis))
-        setattr_(self, "joint_pitch", _readonly(pitch))
-        setattr_(self, "X_tree_R", _readonly(R))
-        setattr_(self, "X_tree_p", _readonly(p))
-        setattr_(self, "theta", _readonly(theta))
-        setattr_(self, "idx_q", _readonly(idx_q, np.int64))
-        setattr_(self, "idx_v", _readonly(idx_v, np.int64))
+        setattr_(self, "parent", readonly(parent, np.int64))
+        setattr_(self, "joint_type", readonly(jt, np.int64))
+        setattr_(self, "joint_axis", readonly(axis))
+        setattr_(self, "joint_pitch", readonly(pitch))
+        setattr_(self, "X_tree_R", readonly(R))
+        setattr_(self, "X_tree_p", readonly(p))
+        setattr_(self, "theta", readonly(theta))
+        setattr_(self, "idx_q", readonly(idx_q, np.int64))
+        setattr_(self, "idx_v", readonly(idx_v, np.int64))
         setattr_(self, "nq", nq)
         setattr_(self, "nv", nv)
         setattr_(self, "link_names", tuple(names))
         setattr_(self, "body_joint_names", tuple(jnames))
         setattr_(self, "joint_names", tuple(one_dof))
-        setattr_(self, "lower", _readonly(lo))
-        setattr_(self, "upper", _readonly(hi))
+        setattr_(self, "lower", readonly(lo))
+        setattr_(self, "upper", readonly(hi))
         for key, a in dofs.items():
-            setattr_(self, key, _readonly(a))
+            setattr_(self, key, readonly(a))
         setattr_(self, "coulomb_smoothing", float(coulomb_smoothing))
-        setattr_(self, "gravity", _readonly(g))
+        setattr_(self, "gravity", readonly(g))
         setattr_(self, "frame_names", tuple(fnames))
-        setattr_(self, "frame_body", _readonly(fb, np.int64))
-        setattr_(self, "frame_R", _readonly(fR))
-        setattr_(self, "frame_p", _readonly(fp))
+        setattr_(self, "frame_body", readonly(fb, np.int64))
+        setattr_(self, "frame_R", readonly(fR))
+        setattr_(self, "frame_p", readonly(fp))
         index = {n: i for i, n in enumerate(all_names)}
         setattr_(self, "_frame_index", index)
         setattr_(self, "kernel", pack(self))

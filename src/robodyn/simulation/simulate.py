@@ -278,10 +278,6 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "simulate()")
-    if is_coupled(model):
-        return _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, contacts=contacts, f_ext=f_ext,
-                                 frame=frame, constraints=constraints, baumgarte=baumgarte, rtol=rtol, atol=atol,
-                                 progress=progress, stiction=stiction)
     q0 = _vector("q0", q0, model.nq)
     v0 = _vector("v0", v0, model.nv)
     duration, dt = positive_number("duration", duration), positive_number("dt", dt)
@@ -316,6 +312,10 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if cmodel is not None and sizes != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
+    if is_coupled(model):
+        return _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, contacts=contacts, f_ext=f_ext,
+                                 frame=frame, constraints=constraints, baumgarte=baumgarte, rtol=rtol, atol=atol,
+                                 progress=progress, stiction=stiction)
     unit_configuration(model, q0)
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
@@ -374,15 +374,8 @@ def _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, *, co
         raise ValueError(f"simulate: {'contacts' if contacts is not None else 'stiction'} with mimic couplings "
                          "(a CoupledModel) are not supported: the couplings are held as bilateral constraints, "
                          "which do not combine with them; load the robot with mimic='independent'")
-    if controller is not None and not callable(controller):
-        raise ValueError(f"controller: expected None or a callable (t, q, v) -> tau, got {type(controller).__name__}")
-    cmodel = getattr(controller, "model", model)
-    if (getattr(cmodel, "nq", model.nq), getattr(cmodel, "nv", model.nv)) != (model.nq, model.nv):
-        raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
-                         f"nq={model.nq}, nv={model.nv}")
     user = () if constraints is None else (constraints if isinstance(constraints, (list, tuple)) else (constraints,))
-    q0f, v0f, law, held = coupled.full_tree_problem(model, _vector("q0", q0, model.nq), _vector("v0", v0, model.nv),
-                                                    controller, user)
+    q0f, v0f, law, held = coupled.full_tree_problem(model, q0, v0, controller, user)
     traj = simulate(model.full, q0f, v0f, duration, dt, law, integrator, constraints=held, **options)
     return coupled.reduced_trajectory(model, traj, bool(user))
 
