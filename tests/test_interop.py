@@ -9,7 +9,7 @@ ANYmal with a Kinova arm, a continuous double pendulum), fixed and floating base
 (c) robodyn -> Pinocchio -> robodyn gives the same model and the same dynamics;
 
 plus a hand-built Pinocchio tree with every joint type robodyn converts, and the errors
-(joint types robodyn lacks, mimic joints, Pinocchio missing). Seeded random states; relative
+(joint types robodyn lacks, Pinocchio missing), and mimic joints as couplings. Seeded random states; relative
 error (max abs difference / max(1, max abs of the reference)) below 1e-9. Pinocchio's
 dynamics leave joint friction out, so robodyn runs with ``friction=False`` against it.
 """
@@ -295,11 +295,15 @@ MIMIC_URDF = """<robot name="gripper">
 </robot>"""
 
 
-def test_mimic_joints_are_an_error():
+def test_mimic_joints_become_couplings():
+    """A JointModelMimic is a mimic coupling (both ways; more in test_mimic_interop.py)."""
+    from test_mimic_interop import assert_same_dynamics as assert_same_coupled
+
     pm = pin.buildModelFromXML(MIMIC_URDF, mimic=True)
-    with pytest.raises(rd.ModelError, match="joint 'right_finger' is a mimic joint "
-                                            r"\(JointModelMimic of 'left_finger'\).*mimic=False.*CouplingConstraint"):
-        from_pinocchio(pm)
+    model = from_pinocchio(pm)
+    assert isinstance(model, rd.CoupledModel) and model.mimic == (("right_finger", "left_finger", 1.0, 0.0),)
+    assert model.joint_names == ("left_finger",) and model.full.joint_names == ("left_finger", "right_finger")
+    assert_same_coupled(model, pm, "gripper")  # Pinocchio's aba does not take mimic joints
     model = from_pinocchio(pin.buildModelFromXML(MIMIC_URDF))  # without mimic: two independent joints
     assert model.joint_names == ("left_finger", "right_finger")
 

@@ -338,7 +338,7 @@ def test_coupled_model_checks_its_couplings():
         rd.CoupledModel("robot", [])
 
 
-def test_functions_without_couplings_say_so(tmp_path):
+def test_functions_without_couplings_say_so():
     """What does not take a coupled model yet refuses it, saying so, never with a wrong answer:
     every field in the full tree's coordinates raises."""
     model = MODELS[0]
@@ -350,13 +350,8 @@ def test_functions_without_couplings_say_so(tmp_path):
         assert not hasattr(model, key)
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         _ = model.nonsense
-    from robodyn.interop import to_pinocchio
-
-    for call in (lambda: rd.write_mjcf(model, tmp_path / "m.xml"), lambda: to_pinocchio(model),
-                 lambda: rd.symbolic.from_model(model),
-                 lambda: rd.rollout(model, np.stack([q, q]), q * 0, 0.01, 0.001)):
-        with pytest.raises(rd.ModelError, match=say):
-            call()
+    with pytest.raises(rd.ModelError, match=say):
+        rd.rollout(model, np.stack([q, q]), q * 0, 0.01, 0.001)
 
 
 # -- URDF files ---------------------------------------------------------------------------
@@ -593,12 +588,38 @@ def test_command_line_on_a_urdf_with_mimic_joints(capsys, tmp_path):
         assert "20 steps" in capsys.readouterr().out
         assert main(["view", path, "--png", str(tmp_path / "panda.png")]) == 0
         assert (tmp_path / "panda.png").stat().st_size > 1000
-        for argv in (["derive", path], ["bench", path], ["simulate", path, "--ground", "--duration", "0.01"]):
+        for argv in (["bench", path], ["simulate", path, "--ground", "--duration", "0.01"]):
             assert main(argv) == 2
             err = capsys.readouterr().err
             assert "has mimic joints (1 coupled)" in err and "--mimic independent" in err and "Traceback" not in err
         assert main(["info", path, "--mimic", "independent"]) == 0
         assert "Model 'panda': nq=9, nv=9" in capsys.readouterr().out
+
+
+def test_excite_and_identify_commands_on_a_coupled_model(capsys, tmp_path):
+    """robodyn excite writes a trajectory of the independent joints; robodyn identify, on that
+    trajectory with the coupled model's torques, writes a URDF with the <mimic> element whose
+    model reproduces the torques."""
+    from robodyn.cli import main
+    from robodyn.io.log import read_log, write_log
+
+    path = str(_path("panda_description/urdf/panda.urdf"))
+    model = _load(_path("panda_description/urdf/panda.urdf"))
+    traj = tmp_path / "excite.csv"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        assert main(["excite", path, "--duration", "2", "--period", "2", "--harmonics", "2", "--samples", "30",
+                     "--maxiter", "3", "--rate", "100", "--out", str(traj)]) == 0
+        log = read_log(traj, model)
+        assert log.q.shape[1] == model.nv == 8
+        data = tmp_path / "data.csv"
+        write_log(data, model, log.t, log.q, v=log.v, a=log.a, tau=rd.rnea(model, log.q, log.v, log.a))
+        assert main(["identify", path, str(data), "--out", str(tmp_path / "id.urdf")]) == 0
+        assert "Traceback" not in capsys.readouterr().err
+        found = rd.load_urdf(tmp_path / "id.urdf")
+    assert isinstance(found, rd.CoupledModel) and found.mimic == model.mimic
+    tau = rd.rnea(model, log.q, log.v, log.a)
+    assert_rel(rd.rnea(found, log.q, log.v, log.a), tau, 1e-6)
 
 
 @pytest.mark.parametrize("integrator", ["semi_implicit_euler", "rk4"])

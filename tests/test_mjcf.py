@@ -394,12 +394,13 @@ def test_sites_are_frames_and_name_clashes_are_prefixed():
 def test_ignored_elements_are_listed_in_one_warning():
     xml = _mjcf('<body name="b"><joint name="j" type="ball" stiffness="3" range="0 1"/><geom size="0.1"/>'
                 '<camera name="c"/></body>',
-                top='<actuator><motor joint="j"/></actuator><tendon/><equality/><sensor/><asset/><visual/>')
+                top='<actuator><motor joint="j"/></actuator><tendon/><equality><weld body1="b"/></equality><sensor/>'
+                    '<asset/><visual/>')
     with pytest.warns(rd.RobodynWarning) as rec:
         rd.load_mjcf(xml)
     assert len(rec) == 1
     msg = str(rec[0].message)
-    for tag in ("actuator", "tendon", "equality", "sensor"):
+    for tag in ("actuator", "tendon", "equality/weld", "sensor"):
         assert f"1 <{tag}>" in msg
     assert "springs of ball and free joints (stiffness) not modelled: ['j']" in msg
     assert "cone limits of ball joints (range) not modelled: ['j']" in msg  # autolimits: range given

@@ -16,7 +16,7 @@ from ..coupling import is_coupled
 def load_model(spec: str, floating_base: bool = False, physical: str = "error", mimic: str = "couple"):
     """A built-in robot by name, a MuJoCo model (``.xml``, ``.mjcf``) or a URDF file by path, or
     a URDF of example-robot-data by its name (``solo12``) when that package is installed
-    (``mimic``: see :func:`robodyn.load_urdf`)."""
+    (``mimic``: see :func:`robodyn.load_urdf` and :func:`robodyn.load_mjcf`)."""
     from ..io.mjcf import load_mjcf
     from ..io.urdf import load_urdf
 
@@ -27,7 +27,7 @@ def load_model(spec: str, floating_base: bool = False, physical: str = "error", 
     if spec.lower().endswith((".xml", ".mjcf")):
         if floating_base:
             raise ValueError("--floating-base applies to URDF files; a MuJoCo model declares its free joints")
-        return load_mjcf(spec, physical=physical)
+        return load_mjcf(spec, physical=physical, mimic=mimic)
     if spec.endswith(".urdf") or "/" in spec:
         return load_urdf(spec, floating_base=floating_base, physical=physical, mimic=mimic)
     found = models.example_robot_urdf(spec)
@@ -44,7 +44,8 @@ def add_model_arguments(p, default=None) -> None:
     p.add_argument("--physical", choices=("error", "warn"), default="error",
                    help="reject (error) or keep with a warning (warn) unphysical inertias")
     p.add_argument("--mimic", choices=("couple", "independent"), default="couple",
-                   help="URDF <mimic> joints: follow their source joint (couple) or move as independent joints")
+                   help="URDF <mimic> joints and MJCF joint equalities: follow their source joint (couple) "
+                   "or move as independent joints")
 
 
 def loaded(args, command: str | None = None):

@@ -14,16 +14,12 @@ from pathlib import Path
 from .common import add_model_arguments, check_output_dir, check_output_file, loaded, save, written
 
 
-def _model(args):
-    return loaded(args, args.command)
-
-
 def cmd_excite(args) -> int:
     from ..identification.base import base_parameters
     from ..identification.excitation import limits_of, optimize_excitation, write_excitation
 
     check_output_file(args.out, "--out")
-    model = _model(args)
+    model = loaded(args)
     base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction,
                            stiffness=args.stiffness)
     period = args.period if args.period is not None else args.duration
@@ -48,7 +44,7 @@ def cmd_identify(args) -> int:
 
     check_output_file(args.out, "--out")
     check_output_dir(args.report, "--report")
-    model = _model(args)
+    model = loaded(args)
     log = preprocess(read_log(args.data, model, require_tau=True), cutoff=args.cutoff, decimate=args.decimate)
     base = base_parameters(model, damping=not args.no_friction, coulomb=not args.no_friction,
                            stiffness=args.stiffness, offset=args.offset)

@@ -23,8 +23,9 @@ How the two models correspond (both are trees with parents before children):
   joints map to robodyn's; ``JointModelUniversal`` (``R = Rot(axis1, q1) Rot(axis2, q2)``)
   becomes two revolute joints ``<name>[1]``, ``<name>[2]`` on a massless cross link
   ``<link>:<name>``, as ``ModelBuilder`` builds a universal joint (same ``q``, ``v``; one body
-  more). Other Pinocchio joints (translation, spherical ZYX, composite, ...) and mimic joints
-  raise ``ModelError``.
+  more). ``JointModelMimic`` joints are robodyn's mimic couplings (a
+  :class:`~robodyn.coupling.CoupledModel`, both ways). Other Pinocchio joints (translation,
+  spherical ZYX, composite, ...) raise ``ModelError``.
 - ``q``: a free joint is ``[x, y, z, qx, qy, qz, qw]`` (unit quaternion, scalar last) in both,
   with ``v = [v_lin, omega]`` in the child (base) frame in both: no conversion. A continuous
   joint is ``(cos t, sin t)`` (2 entries) in Pinocchio and ``t`` in robodyn:
@@ -52,6 +53,7 @@ import numpy as np
 
 from .. import joints as J
 from ..errors import ModelError, RobodynWarning
+from ..coupling import CoupledModel, is_coupled
 from ..model import Model, check_inertial_parameters, inertia_about_origin
 
 # Pinocchio's "unbounded" (the default of its limits) is the largest double.
@@ -106,8 +108,17 @@ def _check_depth_first(model: Model) -> None:
                              "Pinocchio needs (its parent is not body i - 1 or one of its ancestors)")
 
 
+def _aligned(axis) -> int | None:
+    """0, 1, 2 if ``axis`` is +x, +y or +z exactly, else None."""
+    k = int(np.argmax(np.abs(axis)))
+    return k if axis[k] == 1.0 else None
+
+
 def _pin_joint(pin, jtype: int, axis: np.ndarray, pitch: float = 0.0):
     if jtype == J.HELICAL:
+        k = _aligned(axis)
+        if k is not None:
+            return (pin.JointModelHX, pin.JointModelHY, pin.JointModelHZ)[k](float(pitch))
         return pin.JointModelHelicalUnaligned(np.asarray(axis, dtype=float), float(pitch))
     if jtype == J.FREE:
         return pin.JointModelFreeFlyer()
@@ -117,8 +128,8 @@ def _pin_joint(pin, jtype: int, axis: np.ndarray, pitch: float = 0.0):
         return pin.JointModelPlanar()
     aligned = {J.REVOLUTE: (pin.JointModelRX, pin.JointModelRY, pin.JointModelRZ),
                J.PRISMATIC: (pin.JointModelPX, pin.JointModelPY, pin.JointModelPZ)}[jtype]
-    k = int(np.argmax(np.abs(axis)))
-    if axis[k] == 1.0:
+    k = _aligned(axis)
+    if k is not None:
         return aligned[k]()
     unaligned = pin.JointModelRevoluteUnaligned if jtype == J.REVOLUTE else pin.JointModelPrismaticUnaligned
     return unaligned(*axis)
@@ -132,7 +143,7 @@ def _pin_inertia(pin, theta: np.ndarray):
     return pin.Inertia(0.0, np.zeros(3), inertia_about_origin(theta))
 
 
-def to_pinocchio(model: Model):
+def to_pinocchio(model: Model | CoupledModel):
     """The same robot as a ``pinocchio.Model``: same joints in the same order, same ``q``/``v``.
 
     Converted: the tree (joint ``j = i + 1`` for body ``i``, named ``model.body_joint_names[i]``),
@@ -147,11 +158,20 @@ def to_pinocchio(model: Model):
     counterpart. Conventions and frames: see :mod:`robodyn.interop.pinocchio`; ``q``, ``v``,
     ``a`` and ``tau`` can be passed unchanged to Pinocchio's functions.
 
+    A model with mimic joints (:class:`~robodyn.coupling.CoupledModel`) becomes its tree with
+    each mimic joint turned into a ``JointModelMimic`` of its source (``transformJointIntoMimic``):
+    Pinocchio's ``q``, ``v`` are then the independent coordinates, in robodyn's order. Pinocchio
+    needs each source before its mimic joint, and its mimic of a helical joint is not usable
+    (``ValueError`` for both); it keeps no limits, damping, friction or armature of a mimic
+    joint (a warning names those that are lost).
+
     Pinocchio's subtree algorithms (its CRBA) need the bodies in depth-first order; a model in
     another order (a random tree, say) raises ``ValueError``. Pinocchio is imported here (an
     optional dependency); without it this raises ``ImportError`` (``pip install pin``).
     """
     pin = _import_pinocchio("to_pinocchio")
+    if is_coupled(model):
+        return _mimic_to_pinocchio(pin, model, to_pinocchio(model.full))
     _check_depth_first(model)
     pm = pin.Model()
     pm.name = model.name
@@ -193,6 +213,33 @@ def to_pinocchio(model: Model):
     return pm
 
 
+def _mimic_to_pinocchio(pin, model: CoupledModel, pm):
+    """``pm`` (the full tree's Pinocchio model) with the mimic joints of ``model`` turned into
+    ``JointModelMimic`` joints (Pinocchio joint ``i + 1`` is robodyn body ``i``)."""
+    full = model.full
+    body = {name: i for i, name in enumerate(full.body_joint_names)}
+    lost = []
+    for joint, source, r, o in model.mimic:
+        i, s = body[joint], body[source]
+        if s > i:
+            raise ValueError(f"to_pinocchio: mimic joint {joint!r} comes before its source {source!r} in the tree; "
+                             "Pinocchio's mimic joints need the source first")
+        if full.joint_type[i] == J.HELICAL:  # checked against the gradient of the potential energy
+            raise ValueError(f"to_pinocchio: mimic joint {joint!r} is helical; Pinocchio's mimic of a helical "
+                             "joint is not usable (4.1 computes a wrong rnea for JointModelHX/HY/HZ and crashes on "
+                             "JointModelHelicalUnaligned); convert model.full and couple it in Pinocchio otherwise")
+        k = full.idx_v[i]
+        kept = [f"{field} {getattr(full, field)[k]:g}" for field in ("damping", "coulomb", "armature", "stiffness")
+                if getattr(full, field)[k] != 0]
+        if kept:
+            lost.append(f"{joint!r} ({', '.join(kept)})")
+        pm = pin.transformJointIntoMimic(pm, s + 1, i + 1, float(r), float(o))
+    if lost:
+        warnings.warn(f"to_pinocchio: a Pinocchio mimic joint has no damping, friction, armature or spring: not "
+                      f"converted for {', '.join(lost)}", RobodynWarning, stacklevel=3)
+    return pm
+
+
 # ---------------------------------------------------------------------------------------
 # Pinocchio -> robodyn
 
@@ -202,12 +249,7 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
     jm, name = pm.joints[j], pm.names[j]
     kind = jm.shortname()
     if kind == "JointModelMimic":
-        mimicked = [pm.names[m] for k, m in zip(pm.mimicking_joints, pm.mimicked_joints) if k == j]
-        raise ModelError(
-            f"{source}: joint {name!r} is a mimic joint (JointModelMimic of {', '.join(map(repr, mimicked))}), "
-            "which from_pinocchio does not convert; load the URDF with rd.load_urdf (a CoupledModel with the "
-            "same couplings), or build the Pinocchio model without mimic joints (buildModelFromUrdf(..., "
-            "mimic=False)) and couple the joints with rd.CouplingConstraint")
+        return _mimic_type_and_axis(pm, j, source)
     if kind == "JointModelUniversal":  # R = Rot(axis1, q1) Rot(axis2, q2): two revolute joints
         u = jm.extract()  # the JointModelUniversal itself (its data's S is not reliably filled by calc(q))
         return UNIVERSAL, np.stack([np.asarray(u.axis1, dtype=float), np.asarray(u.axis2, dtype=float)]), 0.0
@@ -231,6 +273,44 @@ def _joint_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, floa
     return jtype, (S[3:] if jtype == J.REVOLUTE else S[:3]), 0.0
 
 
+def _mimic_source(pm, j: int) -> int:
+    """The Pinocchio joint that mimic joint ``j`` follows: the joint whose velocity it shares
+    (``idx_v``; ``mimicked_joints`` is not kept in the order of ``mimicking_joints``)."""
+    return next(k for k in range(1, pm.njoints) if pm.joints[k].shortname() != "JointModelMimic"
+                and pm.joints[k].nv == 1 and pm.joints[k].idx_v == pm.joints[j].idx_v)
+
+
+def _mimic_type_and_axis(pm, j: int, source: str) -> tuple[int, np.ndarray, float]:
+    """Type, axis and pitch of the joint inside Pinocchio mimic joint ``j`` (which Python does
+    not expose), from its motion: ``X_J(t) = jointPlacement^-1 liMi`` at ``t = 1`` (the source
+    moved to ``(1 - offset) / scaling`` from the neutral configuration) is ``Rot(a, 1)`` for a
+    revolute joint, ``Trans(a)`` for a prismatic one and ``Rot(a, 1) Trans(h a)`` for a helical
+    one of pitch ``h``."""
+    import pinocchio as pin
+
+    jm = pm.joints[j].extract()
+    p = pm.joints[_mimic_source(pm, j)]
+    if jm.scaling == 0 or p.nv != 1:
+        raise ModelError(f"{source}: mimic joint {pm.names[j]!r}: scaling {jm.scaling} of a {p.shortname()}; "
+                         "robodyn couples joints of one dof with a non-zero multiplier")
+    dv = np.zeros(pm.nv)
+    dv[p.idx_v] = (1.0 - jm.offset) / jm.scaling
+    data = pm.createData()
+    pin.forwardKinematics(pm, data, pin.integrate(pm, pin.neutral(pm), dv))
+    X = pm.jointPlacements[j].inverse() * data.liMi[j]
+    w, t = np.asarray(pin.log3(X.rotation), dtype=float), np.asarray(X.translation, dtype=float)
+
+    def unit(x):
+        x = np.where(np.abs(x) < 1e-14, 0.0, x)
+        return x / np.linalg.norm(x)
+
+    if np.linalg.norm(w) < 1e-12:
+        return J.PRISMATIC, unit(t), 0.0
+    axis = unit(w)
+    pitch = float(t @ axis)
+    return (J.HELICAL, axis, pitch) if abs(pitch) > 1e-14 else (J.REVOLUTE, axis, 0.0)
+
+
 def _link_names_and_frames(pin, pm):
     """The name of each body (its joint's first ``BODY`` frame with identity placement, else the
     joint's name) and the other ``BODY``/``OP_FRAME``/``SENSOR`` frames as
@@ -248,7 +328,7 @@ def _link_names_and_frames(pin, pm):
     return names, frames
 
 
-def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
+def from_pinocchio(pin_model, *, physical: str = "error") -> Model | CoupledModel:
     """The robodyn :class:`~robodyn.model.Model` of a ``pinocchio.Model``, joints in the same order.
 
     Converted: the tree (body ``i`` for Pinocchio joint ``j = i + 1``, joint named
@@ -272,9 +352,14 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
     ``physical="error"`` rejects bodies whose inertia no rigid body can have (``ModelError``),
     ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, as ``load_urdf``.
 
+    Mimic joints (``JointModelMimic``, e.g. ``buildModelFromUrdf(..., mimic=True)``) make a
+    :class:`~robodyn.coupling.CoupledModel`: its tree has the mimic joints as ordinary joints
+    (the joint inside each ``JointModelMimic``: revolute, prismatic or helical, without limits,
+    damping, friction or armature, which Pinocchio does not keep for them), coupled to their
+    source by Pinocchio's ``scaling`` and ``offset``; ``q``, ``v`` are Pinocchio's.
+
     Raises ``ModelError`` naming the joint for joint types robodyn has no counterpart of
-    (translation, composite, spherical ZYX, ...), mimic joints and
-    free flyers below the root. ``rotorInertia`` and ``rotorGearRatio`` (not used by
+    (translation, composite, spherical ZYX, ...) and free flyers below the root. ``rotorInertia`` and ``rotorGearRatio`` (not used by
     Pinocchio's dynamics, which use ``armature``) are not converted: a non-zero
     ``rotorInertia`` is reported by a warning.
     """
@@ -321,7 +406,19 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
                + ("JointModelUniversal",)):
         k, n = jm.idx_v, jm.nv  # one q entry per dof
         lower[k:k + n], upper[k:k + n] = q_lower[jm.idx_q:jm.idx_q + n], q_upper[jm.idx_q:jm.idx_q + n]
-    dofs = {field: _from_pin_bound(getattr(pm, name)) for field, name, _ in _BOUNDS}
+    # a mimic joint has no dof of Pinocchio's: -1 in dof_of (the tree's dof -> Pinocchio's), and
+    # no limits, damping, friction or armature
+    mimic = [j for j in joints if pm.joints[j].shortname() == "JointModelMimic"]
+    dof_of = np.concatenate([np.full(pm.joints[j].extract().nvExtended, -1) if j in mimic
+                             else np.arange(pm.joints[j].idx_v, pm.joints[j].idx_v + pm.joints[j].nv)
+                             for j in joints] or [np.zeros(0, int)]).astype(int)
+
+    def per_dof(x, fill):
+        return np.where(dof_of >= 0, np.asarray(x, dtype=float)[dof_of], fill)
+
+    lower, upper = per_dof(lower, -np.inf), per_dof(upper, np.inf)
+    dofs = {field: per_dof(_from_pin_bound(getattr(pm, name)), np.inf if field != "coulomb" else 0.0)
+            for field, name, _ in _BOUNDS}
     if np.any(np.asarray(pm.rotorInertia) != 0):
         warnings.warn(f"{source}: rotorInertia {np.asarray(pm.rotorInertia).tolist()} not converted "
                       "(Pinocchio's dynamics use armature; add rotorInertia * rotorGearRatio**2 to the "
@@ -331,16 +428,21 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model:
         warnings.warn(f"{source}: angular part {gravity.angular.tolist()} of gravity ignored",
                       RobodynWarning, stacklevel=2)
     nb = len(bodies["parent"])
-    return Model(
+    full = Model(
         parent=bodies["parent"], joint_type=bodies["jtype"], joint_axis=np.reshape(bodies["axis"], (nb, 3)),
         joint_pitch=np.asarray(bodies["pitch"], dtype=float), X_tree_R=np.reshape(bodies["R"], (nb, 3, 3)),
         X_tree_p=np.reshape(bodies["p"], (nb, 3)), theta=np.reshape(bodies["theta"], (nb, 10)),
         link_names=bodies["link"], body_joint_names=bodies["joint"],
-        gravity=gravity.linear, lower=lower, upper=upper, damping=pm.damping, armature=pm.armature,
+        gravity=gravity.linear, lower=lower, upper=upper, damping=per_dof(pm.damping, 0.0),
+        armature=per_dof(pm.armature, 0.0),
         frame_names=[f[0] for f in frames], frame_body=[body_of[f[1] + 1] for f in frames],
         frame_R=np.reshape([f[2] for f in frames], (-1, 3, 3)), frame_p=np.reshape([f[3] for f in frames], (-1, 3)),
         name=pm.name, physical=physical, **dofs,
     )
+    if not mimic:
+        return full
+    return CoupledModel(full, [(pm.names[j], pm.names[_mimic_source(pm, j)], pm.joints[j].extract().scaling,
+                                pm.joints[j].extract().offset) for j in mimic])
 
 
 # ---------------------------------------------------------------------------------------

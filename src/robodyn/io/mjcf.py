@@ -25,14 +25,20 @@ Reads what a robot description uses, with MuJoCo's own rules (its compiler, ``us
 - ``<default>`` classes with inheritance (``class``, ``childclass``), ``<include file>``
   (relative to the main file's folder), ``<option gravity>`` and its gravity flag, named
   ``<site>`` elements as frames (``site:name`` where a body already has the name).
+- ``<equality><joint joint1 joint2 polycoef>`` with a linear polynomial (``polycoef="a0 a1 0 0
+  0"``, the default ``"0 1 0 0 0"``) between two named hinge or slide joints: ``joint1`` follows
+  ``joint2`` exactly, a mimic joint (:class:`~robodyn.coupling.CoupledModel`; ``mimic=
+  "independent"`` keeps both as degrees of freedom). MuJoCo holds the equality softly
+  (``solref``, ``solimp``); robodyn holds it exactly.
 
 Refused with a :class:`~robodyn.model.ModelError` naming the file, element and line: inertia
 from mesh, height-field or
 SDF geoms (give the body an ``<inertial>``), shell inertia, elements that generate bodies
 (``<composite>``, ``<flexcomp>``, ``<replicate>``, ``<attach>``), global coordinates, a free
 joint below a moving body. Ignored with one :class:`~robodyn.errors.RobodynWarning` listing
-them: elements that are not the rigid-body dynamics of the tree (actuators, tendons,
-equality constraints, sensors, contact pairs, ...), springs of ball and free joints, the cone
+them: elements that are not the rigid-body dynamics of the tree (actuators, tendons, the
+other equality constraints (``connect``, ``weld``, ``tendon``, inactive or polynomial joint
+equalities, a joint locked by an equality without ``joint2``), sensors, contact pairs, ...), springs of ball and free joints, the cone
 limits of ball joints (``range``: a bound on the rotation angle, which robodyn's box limits on
 dofs cannot hold) and gravity compensation (``gravcomp``). Springs of hinge and slide joints (``stiffness``,
 ``springref``) are the model's ``stiffness`` and ``spring_reference``. Visual elements (assets, cameras, lights) are skipped
@@ -52,6 +58,7 @@ from pathlib import Path
 import numpy as np
 
 from ..builder import ModelBuilder
+from ..coupling import CoupledModel
 from ..errors import ModelError, RobodynWarning
 from ..lie import exp_so3, quat_matrix
 from ..model import Model
@@ -63,7 +70,7 @@ MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_INCLUDES = 100
 
 # Elements read, or skipped silently because they draw or store things (no dynamics).
-_TOP_READ = {"compiler", "option", "default", "worldbody", "include"}
+_TOP_READ = {"compiler", "option", "default", "worldbody", "include", "equality"}
 _TOP_SILENT = {"asset", "visual", "statistic", "size", "custom", "extension", "keyframe"}
 _BODY_READ = {"body", "joint", "freejoint", "geom", "site", "inertial", "frame"}
 _BODY_SILENT = {"camera", "light", "plugin"}
@@ -129,11 +136,19 @@ class _Doc:
         return raw
 
 
-def load_mjcf(source, *, physical: str = "error") -> Model:
+def load_mjcf(source, *, physical: str = "error", mimic: str = "couple") -> Model | CoupledModel:
     """Load an MJCF file (path) or XML string into a :class:`Model` (rules in the module
     docstring). Every body tree of ``<worldbody>`` hangs from the fixed world; bodies with a
     free joint are floating bases. ``physical`` as in :func:`~robodyn.io.urdf.load_urdf`.
-    The order of bodies and of ``v`` is MuJoCo's (depth first, in file order)."""
+    The order of bodies and of ``v`` is MuJoCo's (depth first, in file order).
+
+    ``mimic="couple"`` (default): a linear ``<equality><joint joint1 joint2 polycoef>`` makes
+    ``joint1`` follow ``joint2`` exactly (MJCF's mimic joint; MuJoCo enforces it softly), and
+    the model is a :class:`~robodyn.coupling.CoupledModel` of the independent joints, as
+    :func:`~robodyn.io.urdf.load_urdf` reads ``<mimic>``. ``mimic="independent"``: every joint
+    is a degree of freedom (the equalities are ignored, with a warning naming them)."""
+    if mimic not in ("couple", "independent"):
+        raise ValueError(f"mimic must be 'couple' or 'independent', got {mimic!r}")
     text, name = read_source(source, "MJCF", MAX_FILE_BYTES)
     root, lines = parse(text, name)
     doc = _Doc(name, lines)
@@ -153,7 +168,11 @@ def load_mjcf(source, *, physical: str = "error") -> Model:
         reader.children(world, "world", (np.eye(3), np.zeros(3)), "main", world=True)
     b = ModelBuilder(root.get("model", "mujoco"), gravity=gravity, source=name, physical=physical)
     reader.build(b)
+    couplings = _joint_equalities(root, doc, defaults, reader.named, ignored)
     notes = []
+    if couplings and mimic == "independent":
+        notes.append(f"joint equalities loaded as independent joints (mimic='independent'): "
+                     f"{[c[0] for c in couplings]}")
     if ignored:
         notes.append("ignored elements that are not the rigid-body dynamics of the tree: "
                      + ", ".join(f"{n} <{k}>" for k, n in sorted(ignored.items())))
@@ -162,7 +181,42 @@ def load_mjcf(source, *, physical: str = "error") -> Model:
             notes.append(f"{what} not modelled: {names}")
     if notes:
         warnings.warn(f"{name}: " + "; ".join(notes), RobodynWarning, stacklevel=2)
-    return b.build()
+    model = b.build()
+    return CoupledModel(model, couplings) if couplings and mimic == "couple" else model
+
+
+def _joint_equalities(root, doc: _Doc, defaults, named: dict, ignored: Counter) -> list[tuple]:
+    """The linear joint equalities of ``<equality>`` as mimic couplings ``(joint, source,
+    multiplier, offset)``: MuJoCo's ``y - y0 = a0 + a1 (x - x0) + a2 (x - x0)^2 + ...`` (``y``
+    joint1, ``x`` joint2, ``y0``, ``x0`` their ``ref``; robodyn's ``q`` is ``qpos``) with
+    ``a2 = a3 = a4 = 0`` is ``q_y = a1 q_x + (y0 + a0 - a1 x0)``. Inactive ones, those without
+    ``joint2`` (a joint locked at a value), polynomial ones and the other kinds (``connect``,
+    ``weld``, ``tendon``, ``flex``) are counted in ``ignored`` (``equality/<kind>``)."""
+    out = []
+    for group in root.findall("equality"):
+        for e in group:
+            if not isinstance(e.tag, str):
+                continue
+            cls = e.get("class", "main")
+            if cls not in defaults:
+                raise ModelError(f"{doc.where(e)}: unknown default class {cls!r}")
+            a = _override(defaults[cls].get("equality", {}), e.attrib)
+            if e.tag != "joint" or doc.flag(e, a, "active", "true") == "false":
+                ignored[f"equality/{e.tag}" + (" (inactive)" if e.tag == "joint" else "")] += 1
+                continue
+            y, x = a.get("joint1"), a.get("joint2")
+            for key, joint in (("joint1", y), ("joint2", x)):
+                if joint is not None and (joint not in named or named[joint][0] not in ("hinge", "slide")):
+                    raise ModelError(f"{doc.where(e)}: {key}={joint!r} is not a named hinge or slide joint "
+                                     f"of the model")
+            if y is None:
+                raise ModelError(f"{doc.where(e)}: missing attribute 'joint1'")
+            c = doc.floats(e, a, "polycoef", 5, (0.0, 1.0, 0.0, 0.0, 0.0))
+            if x is None or np.any(c[2:] != 0):
+                ignored["equality/joint (" + ("a locked joint" if x is None else "polynomial") + ")"] += 1
+                continue
+            out.append((y, x, float(c[1]), float(named[y][1] + c[0] - c[1] * named[x][1])))
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -324,6 +378,7 @@ class _Bodies:
                            "cone limits of ball joints (range)": []}
         self.nbody = 0
         self.njoint = 0
+        self.named: dict[str, tuple[str, float]] = {}  # joint named in the file -> (MJCF type, ref in q units)
 
     # attributes with defaults -----------------------------------------------------------
     def attrs(self, elem, cls: str) -> dict:
@@ -457,6 +512,8 @@ class _Bodies:
                 axis = axis / np.linalg.norm(axis)
                 anchor = doc.floats(j, ja, "pos", 3, (0.0, 0.0, 0.0))
                 ref = doc.number(j, ja, "ref", 0.0) * (np.pi / 180 if jtype == "hinge" and self.c.degree else 1.0)
+                if j.get("name"):
+                    self.named[j.get("name")] = (jtype, ref)
                 if jtype == "hinge":  # F Trans(p) Rot(a, q - ref) = [F Trans(p) Rot(a, -ref)] Rot(a, q)
                     place = _compose(frame, (_axis_rotation(axis, -ref), anchor))
                 else:  # F Trans(p + a (q - ref)) = [F Trans(p - a ref)] Trans(a q)

@@ -32,6 +32,7 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from .. import joints as J
+from ..coupling import is_coupled
 from ..errors import RobodynWarning
 from ..files import write_text
 from ..model import mass_com_inertia
@@ -151,7 +152,21 @@ class _Writer:
 
 
 def write_mjcf(model, path=None) -> str:
-    """The MJCF text of ``model`` (module docstring); also written to ``path`` if given."""
+    """The MJCF text of ``model`` (module docstring); also written to ``path`` if given. A model
+    with mimic joints (:class:`~robodyn.coupling.CoupledModel`) is written as its tree with an
+    ``<equality><joint joint1="mimic" joint2="source" polycoef="offset multiplier 0 0 0"/>``
+    per mimic joint (the joints' ``ref`` is 0, so MuJoCo's ``y - y0 = a0 + a1 (x - x0)`` is
+    ``q_mimic = multiplier q_source + offset``; MuJoCo holds it softly, :func:`load_mjcf` reads
+    it back as the same coupling). Only hinge and slide joints can be coupled in MJCF."""
+    mimic = ()
+    if is_coupled(model):
+        mimic, model = model.mimic, model.full
+        names = dict(zip(model.body_joint_names, model.joint_type))
+        helical = [j for j, s, _, _ in mimic if names[j] not in (J.REVOLUTE, J.PRISMATIC)
+                   or names[s] not in (J.REVOLUTE, J.PRISMATIC)]
+        if helical:
+            raise ValueError(f"write_mjcf: mimic couplings of {helical} involve a joint that is not a hinge or "
+                             "slide, which an MJCF joint equality cannot hold")
     lost = []
     if np.any(np.isfinite(model.velocity_limit)):
         lost.append("velocity limits (not written)")
@@ -167,7 +182,13 @@ def write_mjcf(model, path=None) -> str:
     w.sites(-1, "    ")
     for i in w.roots:
         w.body(i, "    ")
-    w.lines += ["  </worldbody>", "</mujoco>"]
+    w.lines.append("  </worldbody>")
+    if mimic:
+        w.lines.append("  <equality>")
+        w.lines += [f"    <joint joint1={quoteattr(j)} joint2={quoteattr(s)} polycoef=\"{numbers([o, r, 0, 0, 0])}\"/>"
+                    for j, s, r, o in mimic]
+        w.lines.append("  </equality>")
+    w.lines.append("</mujoco>")
     if w.bounded:
         w.lines[1] = f'  <compiler angle="radian" autolimits="true" boundinertia="{numbers(w.bound)}"/>'
         lost.append(f"principal inertias below {w.bound:.3g} (point masses, which MuJoCo refuses) of bodies "
