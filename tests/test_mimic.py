@@ -549,7 +549,7 @@ def test_simulation_with_constraints_and_wrenches_on_a_coupled_model():
     assert np.abs(tip - tip[0]).max() < 1e-6
 
 
-def test_simulation_refuses_contacts_and_stiction_on_a_coupled_model():
+def test_simulation_refuses_stiction_on_a_coupled_model():
     model = MODELS[0]
     q0 = rd.random.random_configuration(model, rng_for("refuse"))
     with pytest.raises(ValueError, match="stiction with mimic couplings.*mimic='independent'"):
@@ -557,8 +557,96 @@ def test_simulation_refuses_contacts_and_stiction_on_a_coupled_model():
     from robodyn.contact import Contacts, Plane, Sphere
 
     touch = Contacts([Sphere(model.nbodies - 1, 0.05)], surfaces=[Plane(height=0.0)])
-    with pytest.raises(ValueError, match="contacts with mimic couplings"):
-        rd.simulate(model, q0, np.zeros(model.nv), 0.01, 0.001, contacts=touch)
+    with pytest.raises(ValueError, match="constraints: not with contacts"):
+        rd.simulate(model, q0, np.zeros(model.nv), 0.01, 0.001, contacts=touch,
+                    constraints=rd.CouplingConstraint(*model.joint_names[:2], 1.0))
+
+
+_INERTIAL = '<inertial><origin xyz="{c}"/><mass value="{m}"/><inertia ixx="{i}" iyy="{i}" izz="{i}" ixy="0.0002" ' \
+            'ixz="0" iyz="0.0003"/></inertial>'
+# A body on a free joint, an arm on a hinge and a paddle that turns back by the same angle about the
+# same axis (multiplier -1): the paddle keeps its pose in the body, welded to it.
+LOCKED = """<robot name="locked">
+  <link name="base">{base}</link><link name="arm">{arm}</link><link name="paddle">{paddle}</link>
+  <joint name="hinge" type="continuous"><parent link="base"/><child link="arm"/>
+    <origin xyz="0.1 0.05 -0.02" rpy="0.3 0.2 0.1"/><axis xyz="0.6 0 0.8"/></joint>
+  <joint name="follower" type="{kind}"><parent link="{parent}"/><child link="paddle"/>{origin}
+    <axis xyz="0.6 0 0.8"/>{mimic}</joint>
+</robot>"""
+
+
+def _locked(coupled: bool) -> rd.Model:
+    parts = dict(base=_INERTIAL.format(c="0 0 0.02", m=2.0, i=0.02), arm=_INERTIAL.format(c="0.1 0 0", m=0.5, i=0.004),
+                 paddle=_INERTIAL.format(c="0.05 0.1 -0.03", m=0.7, i=0.006))
+    if coupled:
+        xml = LOCKED.format(kind="continuous", parent="arm", origin="", mimic='<mimic joint="hinge" multiplier="-1"/>',
+                            **parts)
+    else:
+        xml = LOCKED.format(kind="fixed", parent="base", origin='<origin xyz="0.1 0.05 -0.02" rpy="0.3 0.2 0.1"/>',
+                            mimic="", **parts)
+    return rd.load_urdf(xml, floating_base=True)
+
+
+def test_contacts_of_a_coupled_model_are_those_of_its_equivalent_tree():
+    """The coupled model (a paddle on a mimic joint that undoes its arm's turn) falls on the
+    floor, bounces and slides as the tree with the paddle welded to the body: the coupled
+    contact step (G^T M G, J G) against the plain one, same contacts on the same links."""
+    from robodyn.contact import Contacts, Plane, Sphere
+
+    coupled, welded = _locked(True), _locked(False)
+    assert isinstance(coupled, rd.CoupledModel) and coupled.nv == welded.nv == 7 and coupled.full.nv == 8
+
+    def touch(model):
+        return Contacts([Sphere("paddle", 0.03, (0.1, 0.2, -0.05), "p1"), Sphere("paddle", 0.02, (-0.1, 0.0, 0.05), "p2"),
+                         Sphere("arm", 0.025, (0.2, 0.0, 0.0), "arm"), Sphere("base", 0.04, name="base")],
+                        surfaces=[Plane(height=0.0, friction=0.6, restitution=0.3)], tolerance=1e-12,
+                        max_iterations=500)
+
+    q0 = np.array([0.0, 0.0, 0.15, 0.1, -0.2, 0.3, 0.9, 0.4])
+    q0[3:7] /= np.linalg.norm(q0[3:7])
+    v0 = np.array([0.3, -0.1, -0.5, 1.0, 2.0, -1.5, 3.0])
+    runs = [rd.simulate(m, q0, v0, 0.4, 0.001, contacts=touch(m)) for m in (coupled, welded)]
+    a, b = runs
+    assert np.any(a.contact_force[..., 2] > 0) and np.any(a.contact_force[:, 0, 2] > 0)  # the paddle touches
+    assert_rel(a.q, b.q, 1e-8)
+    assert_rel(a.v, b.v, 1e-8)
+    assert_rel(a.contact_force, b.contact_force, 1e-6)
+    assert_rel(a.energy, b.energy, 1e-8)
+    # the full tree's state stayed on the coupling (the paddle's angle is minus the arm's)
+    qf = rd.coupling.expand_q(coupled, a.q)
+    assert_rel(qf[:, 8], -qf[:, 7], 1e-15)
+
+
+HAND = """<robot name="hand">
+  <link name="palm">{palm}</link><link name="left">{finger}</link><link name="right">{finger}</link>
+  <joint name="left" type="prismatic"><parent link="palm"/><child link="left"/><origin xyz="0 0.03 -0.02"/>
+    <axis xyz="0 1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/></joint>
+  <joint name="right" type="prismatic"><parent link="palm"/><child link="right"/><origin xyz="0 -0.03 -0.02"/>
+    <axis xyz="0 -1 0"/><limit lower="0" upper="0.04" effort="20" velocity="0.2"/><mimic joint="left"/></joint>
+</robot>"""
+
+
+def test_a_coupled_gripper_rests_on_the_floor():
+    """A floating palm with two fingers on prismatic joints, the second a mimic of the first
+    (as Panda's hand), standing on its fingertips and palm corners: at rest the normal forces
+    carry the weight, the friction forces of the fingertips cancel, and the fingers keep their
+    coupling."""
+    from robodyn.contact import Contacts, Plane, Sphere
+
+    hand = rd.load_urdf(HAND.format(palm=_INERTIAL.format(c="0 0 0", m=0.6, i=0.002),
+                                    finger=_INERTIAL.format(c="0 0 -0.02", m=0.05, i=0.002)), floating_base=True)
+    assert isinstance(hand, rd.CoupledModel) and hand.nv == 7
+    spheres = [Sphere("palm", 0.01, (x, 0.0, -0.06), f"palm{x:+}") for x in (-0.04, 0.04)]
+    spheres += [Sphere(name, 0.01, (0.0, 0.0, -0.04), name) for name in ("left", "right")]
+    q0 = np.array([0.0, 0.0, 0.08, 0.0, 0.0, 0.0, 1.0, 0.01])
+    run = rd.simulate(hand, q0, np.zeros(7), 1.0, 0.001, contacts=Contacts(spheres, surfaces=[Plane(friction=0.8)]))
+    weight = -hand.full.theta[:, 0].sum() * hand.gravity[2]
+    assert np.all(run.contact_force[-1, :, 2] > 0)
+    assert_rel(run.contact_force[-1, :, 2].sum(), weight, 1e-6)
+    assert_rel(run.contact_force[-1, :, :2].sum(axis=0), np.zeros(2), 1e-6)
+    assert np.abs(run.v[-1]).max() < 1e-6
+    qf = rd.coupling.expand_q(hand, run.q)
+    assert_rel(qf[:, 8], qf[:, 7], 1e-15)
 
 
 def test_joint_pd_on_a_coupled_floating_model():
@@ -574,8 +662,9 @@ def test_joint_pd_on_a_coupled_floating_model():
 
 # -- command line -------------------------------------------------------------------------
 def test_command_line_on_a_urdf_with_mimic_joints(capsys, tmp_path):
-    """info marks the mimic joint, simulate and view run on the coupled model, the commands that
-    do not take couplings say so and how to load the file instead; never a traceback."""
+    """info marks the mimic joint, simulate (with and without the ground) and view run on the
+    coupled model, the command that does not take couplings says so and how to load the file
+    instead; never a traceback."""
     from robodyn.cli import main
 
     path = str(_path("panda_description/urdf/panda.urdf"))
@@ -588,10 +677,12 @@ def test_command_line_on_a_urdf_with_mimic_joints(capsys, tmp_path):
         assert "20 steps" in capsys.readouterr().out
         assert main(["view", path, "--png", str(tmp_path / "panda.png")]) == 0
         assert (tmp_path / "panda.png").stat().st_size > 1000
-        for argv in (["bench", path], ["simulate", path, "--ground", "--duration", "0.01"]):
-            assert main(argv) == 2
-            err = capsys.readouterr().err
-            assert "has mimic joints (1 coupled)" in err and "--mimic independent" in err and "Traceback" not in err
+        assert main(["bench", path]) == 2
+        err = capsys.readouterr().err
+        assert "has mimic joints (1 coupled)" in err and "--mimic independent" in err and "Traceback" not in err
+        assert main(["simulate", path, "--ground", "--duration", "0.01", "--drop", "0.01"]) == 0
+        out = capsys.readouterr().out
+        assert "10 steps" in out and "contacts: 64 on the ground" in out
         assert main(["info", path, "--mimic", "independent"]) == 0
         assert "Model 'panda': nq=9, nv=9" in capsys.readouterr().out
 

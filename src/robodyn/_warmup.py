@@ -77,6 +77,7 @@ def _simulation_steps(rd, model):
     and without contacts."""
     from . import control
     from .contact import Contacts, Plane, Sphere
+    from .joints import NV
     from .random import random_configuration
 
     q0, v0 = random_configuration(model, np.random.default_rng(0)), np.zeros(model.nv)
@@ -93,9 +94,14 @@ def _simulation_steps(rd, model):
     out = [(name, lambda c=c, i=i: rd.simulate(model, q0, v0, 0.004, 0.002, c, i, progress=False))
            for name, c, i in run]
     touch = Contacts([Sphere(model.nbodies - 1, 0.05)], surfaces=[Plane(height=10.0)])  # in contact from the start
+    one = [name for name, t in zip(model.body_joint_names, model.joint_type) if NV[t] == 1]
+    coupled = rd.CoupledModel(model, [(one[-1], one[0], 1.0, 0.0)])
+    qc = random_configuration(coupled, np.random.default_rng(0))
     return out + [(name, lambda c=c: rd.simulate(model, q0, v0, 0.004, 0.002, c, contacts=touch, progress=False))
                   for name, c in (("simulate (contacts)", None), ("simulate (contacts, Python controller)",
                                                                    python_law))] + [
+        ("simulate (contacts, mimic couplings)",
+         lambda: rd.simulate(coupled, qc, np.zeros(coupled.nv), 0.004, 0.002, contacts=touch, progress=False)),
         ("rollout (contacts)", lambda: rd.rollout(model, np.stack([q0, q0]), v0, 0.004, 0.002, pd, contacts=touch))]
 
 
@@ -108,6 +114,7 @@ def _public():
                              energy, frame_derivatives, hybrid, inertia_bounds, integrate, jacobian, kinematics,
                              mass_jacobians, minv, regressor, rnea, rnea_derivatives, rnea_second_derivatives,
                              task_space, terms)
+    from .coupling import CoupledModel
     from .simulation import rollout, simulate
 
     names = {}
@@ -117,7 +124,7 @@ def _public():
                    rnea_derivatives, rnea_second_derivatives, task_space, terms):
         names.update({n: getattr(module, n) for n in dir(module)
                       if not n.startswith("_") and not isinstance(getattr(module, n), ModuleType)})
-    return SimpleNamespace(**names, simulate=simulate, rollout=rollout, random=random)
+    return SimpleNamespace(**names, simulate=simulate, rollout=rollout, random=random, CoupledModel=CoupledModel)
 
 
 def steps():

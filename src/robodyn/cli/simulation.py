@@ -32,8 +32,8 @@ from collections import Counter
 import numpy as np
 
 from .. import models
-from ..coupling import independent_q, joint_tree
-from .common import add_model_arguments, check_output_file, load_model, loaded, refuse_couplings, save, written
+from ..coupling import expand_q, independent_q, is_coupled, joint_tree
+from .common import add_model_arguments, check_output_file, load_model, loaded, save, written
 
 CONTROLLERS = ("none", "pd-gravity", "computed-torque", "stand")
 
@@ -124,7 +124,8 @@ def lift(model, q0, contacts, height: float):
     ``height`` above the ground (unchanged without a free root)."""
     from ..joints import FREE
 
-    roots = [i for i in range(model.nbodies) if model.parent[i] < 0 and model.joint_type[i] == FREE]
+    tree = joint_tree(model)  # with mimic joints: lift the tree's configuration, read it back
+    roots = [i for i in range(tree.nbodies) if tree.parent[i] < 0 and tree.joint_type[i] == FREE]
     if not roots:
         return q0
     from ..algorithms.kinematics import forward_kinematics
@@ -132,10 +133,10 @@ def lift(model, q0, contacts, height: float):
     (body, center, radius), _, _, _ = contacts.pack(model)
     poses = forward_kinematics(model, q0)
     lowest = min(float(poses[b, 2, :3] @ c + poses[b, 2, 3]) - r for b, c, r in zip(body, center, radius))
-    q = q0.copy()
+    q = expand_q(model, q0) if is_coupled(model) else q0.copy()
     for i in roots:
-        q[model.idx_q[i] + 2] += height - lowest
-    return q
+        q[tree.idx_q[i] + 2] += height - lowest
+    return independent_q(model, q)
 
 
 def standing_inertia(model, q0, contacts=None):
@@ -158,14 +159,16 @@ def standing_inertia(model, q0, contacts=None):
     (bodies, centers, _), _, _, _ = contacts.pack(model)
     poses = forward_kinematics(model, q0)
     tips = [(b, poses[b, :3, :3] @ c + poses[b, :3, 3]) for b, c in zip(bodies, centers)]
-    dof_body = {k: i for i in range(model.nbodies) for k in range(model.idx_v[i], model.idx_v[i] + 1)}
+    tree = joint_tree(model)  # a coupled model's dofs are the tree's independent ones
+    tree_dof = np.asarray(getattr(model, "independent_v", np.arange(model.nv)))
+    dof_body = {k: i for i in range(tree.nbodies) for k in range(tree.idx_v[i], tree.idx_v[i] + 1)}
     for j, k in enumerate(actuated):
-        i = dof_body[int(k)]
+        i = dof_body[int(tree_dof[k])]
         reach = 0.0
         for b, x in tips:
             a = b
             while a >= 0 and a != i:
-                a = model.parent[a]
+                a = tree.parent[a]
             if a == i:
                 reach = max(reach, float(np.linalg.norm(x - poses[i, :3, 3])))
         inertia[j] += model.total_mass * reach * reach
@@ -183,8 +186,6 @@ def cmd_simulate(args) -> int:
         args.controller = "stand" if args.ground else "none"
     urdf = args.model not in models.names() and not args.model.lower().endswith((".xml", ".mjcf"))
     model = load_model(args.model, args.floating_base or (args.ground and urdf), args.physical, args.mimic)
-    if args.ground:
-        refuse_couplings(model, "simulate --ground")  # contacts do not combine with the couplings' constraints
     contacts = ground_contacts(model, args) if args.ground else None
     if args.contact_plot and contacts is None:
         raise ValueError("--contact-plot applies to --ground")

@@ -30,14 +30,24 @@ from ._kernels import chart_point, chart_rate
 
 
 @kernel
+def pair_workspace(npairs):
+    """Scratch of :func:`contact_rows` and :func:`contact_velocity` for ``npairs`` pairs (none of
+    it depends on the model): Delassus matrix, free contact velocities, targets, friction,
+    impulses, contact frames, pair indices, the solver's scratch and four 3-vectors."""
+    m3 = 3 * npairs
+    return (np.empty((m3, m3)), np.empty(m3), np.empty(npairs), np.empty(npairs), np.empty(m3),
+            np.empty((npairs, 3, 3)), np.empty(npairs, np.int64),
+            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))),
+            np.empty(3), np.empty(3), np.empty(3), np.empty(3))
+
+
+@kernel
 def workspace(nb, nv, npairs):
     """Scratch of :func:`step` for a model of ``nb`` bodies and ``nv`` dofs and ``npairs`` pairs."""
     m3 = 3 * npairs
     return (crba_workspace(nb, nv), rnea_workspace(nb), np.empty((nv, nv)), np.empty(nv), np.empty(nv),
-            np.zeros(nv), np.empty((m3, nv)), np.empty((nv, m3)), np.empty((m3, m3)), np.empty(m3),
-            np.empty(npairs), np.empty(npairs), np.empty(m3), np.empty((npairs, 3, 3)),
-            np.empty(npairs, np.int64), np.empty((3, 3)), np.empty(nv), np.empty(3),
-            (np.empty((m3, m3)), np.empty((m3, m3)), np.empty((13, m3))), np.empty(3), np.empty(3))
+            np.zeros(nv), np.empty((m3, nv)), np.empty((nv, m3)), np.empty((3, 3)), np.empty(nv),
+            pair_workspace(npairs))
 
 
 @inline
@@ -96,36 +106,18 @@ def _dot(a, b):
     return s
 
 
-@core
-def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
-         tau, a, q1, v1, force, geom, warm, info, ws):
-    """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
-    state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
-    geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the
-    solver's ``info`` (sweeps, residual, active contacts; converged when the residual is at
-    most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous step's impulses in the
-    contact frames (read and written). Returns a status."""
-    cws, rws, M, h, vf, zero, Jc, Y, G, u0, bias, mu, P, frames, pair_of, R, tmp, x, sws, nrm, ysurf = ws
-    nv = v.shape[0]
-    for k in range(nv):
-        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
-    if st != OK:
-        return st
-    st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
-    if st != OK:
-        return st
-    if not cholesky(M):
-        return NONFINITE_RESULT
-    for k in range(nv):
-        tmp[k] = tau[k] - h[k]
-    forward(M, tmp)
-    backward(M, tmp)
-    for k in range(nv):
-        vf[k] = v[k] + dt * tmp[k]
-    moving_frame_terms(ints, v, dt, vf)
+@inline
+def contact_rows(ints, cws, points, centers, radii, surf, settings, v, vf, dt, geom, force, warm, Jc, pws):
+    """The pairs within reach at ``q`` (``cws``: the CRBA's workspace at ``q``, holding the
+    world poses and motion subspaces): every pair's ``geom`` (signed distance, normal) and a
+    zero ``force``; for the ``m`` pairs the step may close (a gap below the margin plus the
+    distance the free motion covers), their Jacobian rows in their contact frames
+    ``Jc[3c:3c + 3]`` (as wide as ``v``), and in ``pws`` (:func:`pair_workspace`) their target
+    normal velocity, friction, pair index and warm-start impulse. ``v``: the velocity at the
+    start of the step, ``vf``: the free velocity at its end. Returns ``m``."""
+    _, _, bias, mu, P, frames, pair_of, _, x, nrm, ysurf, point = pws
     oR, op, oS = cws[1][2], cws[1][3], cws[2]
-    ns = surf.shape[0]
+    nv, ns = v.shape[0], surf.shape[0]
     m = 0
     for p in range(points.shape[0]):
         b, rad = points[p], radii[p]
@@ -149,11 +141,11 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             F, rows = frames[m], Jc[3 * m:3 * m + 3]
             contact_frame(nrm, F)
             for r in range(3):  # the sphere's point nearest the surface
-                tmp[r] = x[r] - rad * F[0, r]
+                point[r] = x[r] - rad * F[0, r]
             for r in range(3):
                 for k in range(nv):
                     rows[r, k] = 0.0
-            point_rows(ints, oS, b, tmp[:3], F, rows, 1.0)
+            point_rows(ints, oS, b, point, F, rows, 1.0)
             if other >= 0:  # the velocity relative to the other body's surface point
                 point_rows(ints, oS, other, ysurf, F, rows, -1.0)
             u_free, u_before = _dot(rows[0], vf), _dot(rows[0], v)
@@ -172,12 +164,22 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             for r in range(3):
                 P[3 * m + r] = warm[pair, r]
             m += 1
-    info[ACTIVE] = m
+    return m
+
+
+@inline
+def contact_velocity(L, Jc, m, vf, settings, info, Y, pws, dv):
+    """The impulses ``P`` of the ``m`` contacts of :func:`contact_rows` (projected Gauss-Seidel
+    on the Delassus matrix ``Jc M^-1 Jc^T``, ``L`` the Cholesky factor of ``M``) and the
+    velocity they add, ``dv = M^-1 Jc^T P`` (zero without contacts); the solver's ``info``."""
+    G, u0, bias, mu, P, _, _, sws, _, _, _, _ = pws
+    nv = L.shape[0]
     for k in range(nv):
-        tmp[k] = 0.0
+        dv[k] = 0.0
+    info[ACTIVE] = m
     info[ITERATIONS], info[RESIDUAL] = 0.0, 0.0
     if m > 0:
-        delassus(M, Jc, m, Y, G)
+        delassus(L, Jc, m, Y, G)
         for r in range(3 * m):  # the free contact velocities minus their targets
             u0[r] = _dot(Jc[r], vf)
         for c in range(m):
@@ -187,17 +189,57 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
             s_ = 0.0
             for r in range(3 * m):
                 s_ += Y[i, r] * P[r]
-            tmp[i] = s_
-        backward(M, tmp)
-    for k in range(nv):
-        v1[k] = vf[k] + tmp[k]
-        a[k] = (v1[k] - v[k]) / dt
-    moving_frame_terms(ints, v, -1.0, a)  # the spatial acceleration M^-1 (tau - h + J^T lambda)
+            dv[i] = s_
+        backward(L, dv)
+
+
+@inline
+def contact_forces(m, dt, force, warm, pws):
+    """Each active pair's force (world axes, ``F^T P / dt``) and its impulse kept as the next
+    step's warm start."""
+    _, _, _, _, P, frames, pair_of, _, _, _, _, _ = pws
     for c in range(m):
         pair, F = pair_of[c], frames[c]
         for r in range(3):
             force[pair, r] = (F[0, r] * P[3 * c] + F[1, r] * P[3 * c + 1] + F[2, r] * P[3 * c + 2]) / dt
             warm[pair, r] = P[3 * c + r]
+
+
+@core
+def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
+         tau, a, q1, v1, force, geom, warm, info, ws):
+    """One step from ``(q, v)``: the applied torque ``tau``, ``a = (v+ - v) / dt``, the next
+    state ``(q1, v1)``, each pair's contact force (world axes, N; zero when apart) and
+    geometry at ``q`` (``geom[pair] = [signed distance (m), surface normal (3)]``), the
+    solver's ``info`` (sweeps, residual, active contacts; converged when the residual is at
+    most ``settings[TOLERANCE]``). ``warm`` (npairs, 3): the previous step's impulses in the
+    contact frames (read and written). Returns a status."""
+    cws, rws, M, h, vf, zero, Jc, Y, R, tmp, pws = ws
+    nv = v.shape[0]
+    for k in range(nv):
+        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
+    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
+    if st != OK:
+        return st
+    st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
+    if st != OK:
+        return st
+    if not cholesky(M):
+        return NONFINITE_RESULT
+    for k in range(nv):
+        tmp[k] = tau[k] - h[k]
+    forward(M, tmp)
+    backward(M, tmp)
+    for k in range(nv):
+        vf[k] = v[k] + dt * tmp[k]
+    moving_frame_terms(ints, v, dt, vf)
+    m = contact_rows(ints, cws, points, centers, radii, surf, settings, v, vf, dt, geom, force, warm, Jc, pws)
+    contact_velocity(M, Jc, m, vf, settings, info, Y, pws, tmp)
+    for k in range(nv):
+        v1[k] = vf[k] + tmp[k]
+        a[k] = (v1[k] - v[k]) / dt
+    moving_frame_terms(ints, v, -1.0, a)  # the spatial acceleration M^-1 (tau - h + J^T lambda)
+    contact_forces(m, dt, force, warm, pws)
     chart_rate(ints, q, zero, v1, R, tmp)
     for k in range(nv):
         tmp[k] *= dt

@@ -8,6 +8,9 @@ Runge-Kutta method (the fixed-step and SciPy integrators alike) keeps linear inv
 ``q_m - r q_s - o`` exactly (Hairer, Lubich, Wanner, *Geometric Numerical Integration*, IV.1,
 Theorem 1.5): the samples, read in the independent coordinates, are the coupled model's own
 integration. The couplings' forces are internal and are not reported.
+
+With contacts the coupled model is stepped itself (:mod:`._coupled_contact_step`: the full
+tree's ``h``, ``M`` and contact rows reduced by ``G``), its state kept on the coupling.
 """
 
 from __future__ import annotations
@@ -78,3 +81,12 @@ def reduced_trajectory(model, traj, user_constraints: bool):
                    q_desired=None if traj.q_desired is None else traj.q_desired[:, iq],
                    v_desired=None if traj.v_desired is None else traj.v_desired[:, iv],
                    constraint_force=cf[:, :cf.shape[1] - len(model.mimic)] if user_constraints else None)
+
+
+def contact_coupling(model) -> tuple:
+    """``(cmap, cscale, independent)`` of :mod:`._coupled_contact_step`: ``G[k, cmap[k]] =
+    cscale[k]``, the only entry of row ``k`` of ``G``, and the full dofs of the independent ones."""
+    G = np.asarray(model.G)
+    cmap = np.abs(G).argmax(axis=1).astype(np.int64)
+    return cmap, np.ascontiguousarray(G[np.arange(G.shape[0]), cmap]), np.ascontiguousarray(model.independent_v,
+                                                                                          dtype=np.int64)

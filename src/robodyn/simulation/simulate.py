@@ -26,8 +26,9 @@ from ..algorithms.rnea import external_wrenches, rnea
 from ..algorithms.status import OK, raise_for_status
 from ..contact import solver as CS
 from ..control.laws import CONSTANT
-from ..errors import RobodynWarning
+from ..errors import RobodynWarning, user_stacklevel
 from . import _contact_step as CK
+from . import _coupled_contact_step as CCK
 from . import _kernels as K
 from . import coupled
 from .stiction import run_stiction
@@ -312,10 +313,18 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     if cmodel is not None and sizes != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
+    options = dict(contacts=contacts, f_ext=f_ext, frame=frame, constraints=constraints, baumgarte=baumgarte,
+                   rtol=rtol, atol=atol, progress=progress, stiction=stiction)
     if is_coupled(model):
-        return _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, contacts=contacts, f_ext=f_ext,
-                                 frame=frame, constraints=constraints, baumgarte=baumgarte, rtol=rtol, atol=atol,
-                                 progress=progress, stiction=stiction)
+        return _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, **options)
+    return _simulate_tree(model, q0, v0, duration, dt, controller, integrator, **options)
+
+
+def _simulate_tree(model, q0, v0, duration, dt, controller, integrator, *, contacts, f_ext, frame, constraints,
+                   baumgarte, rtol, atol, progress, stiction, coupling=None) -> Trajectory:
+    """:func:`simulate` of a tree, its arguments checked; with ``coupling`` (a
+    :class:`~robodyn.coupling.CoupledModel` whose ``full`` is ``model``), the contact steps of
+    the coupled model on the full tree's state (:mod:`._coupled_contact_step`)."""
     unit_configuration(model, q0)
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
@@ -340,13 +349,13 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
     Z = np.empty((n + 1, law.nz))
     Z[0] = law.z0
     compiled = None
-    if integrator in INTEGRATORS and not law.stateful and plant.compiled:
+    if integrator in INTEGRATORS and not law.stateful and plant.compiled and coupling is None:
         compiled = (CONSTANT, None, None, None, None) if controller is None else compiled_law(controller)
     touch = friction = None
     if stiction:
         friction = run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar)[0]
     elif contacts is not None:
-        touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar)
+        touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar, coupling)
     elif compiled is not None:
         _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar)
     elif integrator == SYMPLECTIC:
@@ -369,12 +378,21 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
 def _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, *, contacts, constraints, stiction,
                       **options) -> Trajectory:
     """:func:`simulate` of a model with mimic couplings: its full tree under the couplings
-    (:mod:`robodyn.simulation.coupled`), read back in the independent coordinates."""
-    if contacts is not None or stiction:
-        raise ValueError(f"simulate: {'contacts' if contacts is not None else 'stiction'} with mimic couplings "
-                         "(a CoupledModel) are not supported: the couplings are held as bilateral constraints, "
-                         "which do not combine with them; load the robot with mimic='independent'")
+    (:mod:`robodyn.simulation.coupled`), with contacts by the coupled model's own contact step
+    (:mod:`._coupled_contact_step`), read back in the independent coordinates."""
+    if stiction:
+        raise ValueError("simulate: stiction with mimic couplings (a CoupledModel) is not supported: the couplings "
+                         "are held as bilateral constraints, which the set-valued friction does not combine with; "
+                         "load the robot with mimic='independent'")
     user = () if constraints is None else (constraints if isinstance(constraints, (list, tuple)) else (constraints,))
+    if contacts is not None:
+        if user:
+            raise ValueError("constraints: not with contacts (bilateral constraints and contacts in one solve are "
+                             "not supported yet); model the contacts or the constraints alone")
+        q0f, v0f, law, _ = coupled.full_tree_problem(model, q0, v0, controller, ())
+        traj = _simulate_tree(model.full, q0f, v0f, duration, dt, law, integrator, contacts=contacts,
+                              constraints=None, stiction=False, coupling=model, **options)
+        return coupled.reduced_trajectory(model, traj, False)
     q0f, v0f, law, held = coupled.full_tree_problem(model, q0, v0, controller, user)
     traj = simulate(model.full, q0f, v0f, duration, dt, law, integrator, constraints=held, **options)
     return coupled.reduced_trajectory(model, traj, bool(user))
@@ -443,10 +461,11 @@ class Touch(NamedTuple):
     info: np.ndarray
 
 
-def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar):
+def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar, coupling=None):
     """Time stepping with contacts (see ``_contact_step``): compiled runs under a compiled
     law (in pieces of about 1% of the run when the progress bar is shown), else one compiled
-    step per sample from a Python loop; warns when a solve did not converge."""
+    step per sample from a Python loop (with ``coupling``, the coupled model's step,
+    ``_coupled_contact_step``, on the full tree's state); warns when a solve did not converge."""
     model = plant.model
     (points, centers, radii), surf, settings, names = contacts.pack(model)
     N, nv, nz = Q.shape[0], model.nv, Z.shape[1]
@@ -470,7 +489,10 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
                 raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
             bar.update(b)
     else:
-        ws = CK.workspace(model.nbodies, nv, len(names))
+        step, ws, extra = CK.step_kernel, CK.workspace(model.nbodies, nv, len(names)), ()
+        if coupling is not None:
+            step, ws, extra = CCK.step_kernel, CCK.workspace(model.nbodies, nv, coupling.nv, len(names)), \
+                coupled.contact_coupling(coupling)
         every = max(1, n // 100)
         zdot = np.empty(nz)
         for s in range(N):
@@ -478,8 +500,8 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
             cmd = _command(law, t[s], q, v, z, nv)
             law.rate(t[s], q, v, z, zdot)
             qn, vn = (Q[s + 1], V[s + 1]) if s < n else (np.empty(model.nq), np.empty(nv))
-            status = CK.step_kernel(*plant.args_at(t[s], q, v), *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
-                                    touch.force[s], touch.geometry[s], warm, touch.info[s], ws)
+            status = step(*plant.args_at(t[s], q, v), *extra, *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
+                          touch.force[s], touch.geometry[s], warm, touch.info[s], ws)
             if status != OK:
                 raise_at(model, status, t[s], q, v, cmd)
             if s < n:
@@ -494,7 +516,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
                       f"{N} steps (largest residual {residual[worst]:.3g} m/s at t = {t[worst]:.6g} after "
                       f"{int(touch.info[worst, CS.ITERATIONS])} iterations; the tolerance is "
                       f"{contacts.tolerance:g} m/s); raise Contacts.max_iterations or lower the time step",
-                      RobodynWarning, stacklevel=3)
+                      RobodynWarning, stacklevel=user_stacklevel())
     return touch
 
 

@@ -29,7 +29,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..algorithms.minv import inverse_mass_matrix
-from ..errors import RobodynWarning
+from ..errors import RobodynWarning, user_stacklevel
 
 MAX_ACTIVE_SET = 50
 MAX_SWEEPS = 2000
@@ -140,5 +140,5 @@ def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_abov
     if np.any(bad):
         warnings.warn(f"simulate: the joint friction solve stopped above {warn_above:g} rad/s in {int(bad.sum())} of "
                       f"{n + 1} steps (largest {residual.max():.3g} rad/s, first at t = {t[np.argmax(bad)]:.6g})",
-                      RobodynWarning, stacklevel=3)
+                      RobodynWarning, stacklevel=user_stacklevel())
     return friction, residual
