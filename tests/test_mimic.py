@@ -17,6 +17,7 @@ Oracles, each independent of the map ``tau = G^T tau_full`` the implementation u
 from __future__ import annotations
 
 import pickle
+import re
 import warnings
 
 import numpy as np
@@ -662,9 +663,9 @@ def test_joint_pd_on_a_coupled_floating_model():
 
 # -- command line -------------------------------------------------------------------------
 def test_command_line_on_a_urdf_with_mimic_joints(capsys, tmp_path):
-    """info marks the mimic joint, simulate (with and without the ground) and view run on the
-    coupled model, the command that does not take couplings says so and how to load the file
-    instead; never a traceback."""
+    """info marks the mimic joint; simulate (with and without the ground), view and bench
+    (compared with Pinocchio's mimic joints where Pinocchio runs the algorithm) run on the
+    coupled model; never a traceback."""
     from robodyn.cli import main
 
     path = str(_path("panda_description/urdf/panda.urdf"))
@@ -677,9 +678,11 @@ def test_command_line_on_a_urdf_with_mimic_joints(capsys, tmp_path):
         assert "20 steps" in capsys.readouterr().out
         assert main(["view", path, "--png", str(tmp_path / "panda.png")]) == 0
         assert (tmp_path / "panda.png").stat().st_size > 1000
-        assert main(["bench", path]) == 2
-        err = capsys.readouterr().err
-        assert "has mimic joints (1 coupled)" in err and "--mimic independent" in err and "Traceback" not in err
+        assert main(["bench", path, "--batch", "10"]) == 0
+        out = capsys.readouterr().out
+        assert "no Pinocchio time: Pinocchio does not run that algorithm on mimic joints" in out
+        assert re.search(r"aba \(batch\) +[0-9.]+ *\n", out)  # robodyn's time, no Pinocchio's
+        assert re.search(r"rnea \(batch\) +[0-9.]+ +[0-9.]+ +[0-9.]+", out)
         assert main(["simulate", path, "--ground", "--duration", "0.01", "--drop", "0.01"]) == 0
         out = capsys.readouterr().out
         assert "10 steps" in out and "contacts: 64 on the ground" in out

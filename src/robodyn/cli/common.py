@@ -10,7 +10,6 @@ import tempfile
 from pathlib import Path
 
 from .. import models
-from ..coupling import is_coupled
 
 
 def load_model(spec: str, floating_base: bool = False, physical: str = "error", mimic: str = "couple"):
@@ -48,23 +47,11 @@ def add_model_arguments(p, default=None) -> None:
                    "or move as independent joints")
 
 
-def loaded(args, command: str | None = None):
-    """The model of a command's arguments (:func:`add_model_arguments`); a ``command`` that does
-    not take mimic couplings refuses a model with them (:func:`refuse_couplings`)."""
+def loaded(args):
+    """The model of a command's arguments (:func:`add_model_arguments`)."""
     if args.model is None:
         raise ValueError(f"robodyn {args.command}: give a MODEL (built-in name, URDF or MJCF path)")
-    model = load_model(args.model, args.floating_base, args.physical, args.mimic)
-    if command is not None:
-        refuse_couplings(model, command)
-    return model
-
-
-def refuse_couplings(model, command: str) -> None:
-    """A clear error for a command that does not take mimic couplings."""
-    if is_coupled(model):
-        raise ValueError(f"{command}: {model.name!r} has mimic joints ({len(model.mimic)} coupled), which this "
-                         "command does not take; rerun with --mimic independent (the mimic joints as independent "
-                         "joints)")
+    return load_model(args.model, args.floating_base, args.physical, args.mimic)
 
 
 def check_output_file(path, option: str) -> None:

@@ -110,7 +110,7 @@ def cmd_demo(args) -> int:
 def cmd_bench(args) -> int:
     from ..bench import run_bench
 
-    model = loaded(args, "bench")
+    model = loaded(args)
     return run_bench(model, args.model, batch=args.batch, compare=not args.no_compare)
 
 
