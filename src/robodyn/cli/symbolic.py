@@ -44,7 +44,7 @@ def run_derive(model, args) -> int:
 def cmd_derive(args) -> int:
     check_output_file(args.latex, "--latex")
     check_output_dir(args.c_dir, "--c")
-    return run_derive(loaded(args, "derive"), args)
+    return run_derive(loaded(args), args)
 
 
 def add_commands(sub) -> None:
