@@ -205,6 +205,33 @@ def contact_forces(m, dt, force, warm, pws):
             warm[pair, r] = P[3 * c + r]
 
 
+@inline
+def dynamics_terms(ints, body, dofs, params, fext, fcode, limit, q, v, tau_cmd, zero, tau, h, M, rws, cws):
+    """The start of a step: ``tau`` the command clipped to the effort limits, the bias
+    ``h = rnea(q, v, 0)`` (with the external wrenches) and ``M = crba(q)``. Returns a status."""
+    for k in range(tau.shape[0]):
+        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
+    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
+    if st != OK:
+        return st
+    return crba_one(ints, body, dofs, q, CHECKED, M, cws)
+
+
+@inline
+def next_state(ints, q, zero, dt, v1, q1, R, tmp):
+    """The end of a step: ``q1 = q ⊞ dt v1`` in the chart of ``q``, then ``v1``'s free and
+    planar linear velocities turned into the next frame (:func:`to_next_frame`). Returns a
+    status (non-finite results)."""
+    chart_rate(ints, q, zero, v1, R, tmp)
+    for k in range(tmp.shape[0]):
+        tmp[k] *= dt
+    chart_point(ints, q, tmp, q1)
+    to_next_frame(ints, v1, dt)
+    if not (finite(v1) and finite(q1)):
+        return NONFINITE_RESULT
+    return OK
+
+
 @core
 def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
          tau, a, q1, v1, force, geom, warm, info, ws):
@@ -216,12 +243,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
     contact frames (read and written). Returns a status."""
     cws, rws, M, h, vf, zero, Jc, Y, R, tmp, pws = ws
     nv = v.shape[0]
-    for k in range(nv):
-        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
-    if st != OK:
-        return st
-    st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
+    st = dynamics_terms(ints, body, dofs, params, fext, fcode, limit, q, v, tau_cmd, zero, tau, h, M, rws, cws)
     if st != OK:
         return st
     if not cholesky(M):
@@ -240,14 +262,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
         a[k] = (v1[k] - v[k]) / dt
     moving_frame_terms(ints, v, -1.0, a)  # the spatial acceleration M^-1 (tau - h + J^T lambda)
     contact_forces(m, dt, force, warm, pws)
-    chart_rate(ints, q, zero, v1, R, tmp)
-    for k in range(nv):
-        tmp[k] *= dt
-    chart_point(ints, q, tmp, q1)
-    to_next_frame(ints, v1, dt)
-    if not (finite(v1) and finite(q1)):
-        return NONFINITE_RESULT
-    return OK
+    return next_state(ints, q, zero, dt, v1, q1, R, tmp)
 
 
 @kernel

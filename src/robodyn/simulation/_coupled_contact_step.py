@@ -20,15 +20,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import core, kernel
-from ..algorithms.crba import crba_one
 from ..algorithms.crba import workspace as crba_workspace
-from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
+from ..algorithms.status import NONFINITE_RESULT, OK
 from ..contact.solver import backward, cholesky, forward
-from ._contact_step import contact_forces, contact_rows, contact_velocity, moving_frame_terms, pair_workspace, \
-    to_next_frame
-from ._kernels import chart_point, chart_rate
+from ._contact_step import (contact_forces, contact_rows, contact_velocity, dynamics_terms, moving_frame_terms,
+                            next_state, pair_workspace)
 
 
 @kernel
@@ -51,12 +48,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, cmap, cscale, independent
     ``a`` is ``G (v_r+ - v_r) / dt``. Returns a status."""
     cws, rws, M, h, vf, zero, Jc, Mr, tau_r, vr, vfr, dvr, Jr, Y, R, tmp, pws = ws
     nf, nr = cmap.shape[0], independent.shape[0]
-    for k in range(nf):
-        tau[k] = min(max(tau_cmd[k], -limit[k]), limit[k])
-    st = rnea_one(ints, body, dofs, params, q, v, zero, fext, fcode, CHECKED, h, rws)
-    if st != OK:
-        return st
-    st = crba_one(ints, body, dofs, q, CHECKED, M, cws)
+    st = dynamics_terms(ints, body, dofs, params, fext, fcode, limit, q, v, tau_cmd, zero, tau, h, M, rws, cws)
     if st != OK:
         return st
     for i in range(nr):
@@ -93,14 +85,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, cmap, cscale, independent
         v1[k] = cscale[k] * (vfr[cmap[k]] + dvr[cmap[k]])
         a[k] = (v1[k] - v[k]) / dt + tmp[k]
     contact_forces(m, dt, force, warm, pws)
-    chart_rate(ints, q, zero, v1, R, tmp)
-    for k in range(nf):
-        tmp[k] *= dt
-    chart_point(ints, q, tmp, q1)
-    to_next_frame(ints, v1, dt)
-    if not (finite(v1) and finite(q1)):
-        return NONFINITE_RESULT
-    return OK
+    return next_state(ints, q, zero, dt, v1, q1, R, tmp)
 
 
 @kernel
