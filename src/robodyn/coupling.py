@@ -58,36 +58,20 @@ class CoupledModel:
             raise TypeError(f"full must be a robodyn Model, got {type(full).__name__}")
         setattr_ = object.__setattr__
         body_of = {name: i for i, name in enumerate(full.body_joint_names)}
-        rule = {}
+        entries = []
         for entry in mimic:
             if len(entry) != 4:
                 raise ModelError(f"mimic entries are (joint, source, multiplier, offset), got {entry!r}")
-            joint, source, r, o = entry[0], entry[1], float(entry[2]), float(entry[3])
+            entries.append((entry[0], entry[1], float(entry[2]), float(entry[3])))
+        resolved = follow_chains(full.name, full.body_joint_names, entries)
+        for joint, source, r, o in entries:
             for role, name in (("mimic joint", joint), ("source joint", source)):
-                if name not in body_of:
-                    raise ModelError(f"{full.name}: {role} {name!r} is not a joint of the model")
                 jt = full.joint_type[body_of[name]]
                 if J.NV[jt] != 1:
                     raise ModelError(f"{full.name}: {role} {name!r} is a {J.NAMES[jt]} joint; mimic couplings "
                                      f"take joints of one dof (revolute, prismatic, helical)")
             if not (np.isfinite(r) and np.isfinite(o)):
                 raise ModelError(f"{full.name}: mimic joint {joint!r}: multiplier {r} and offset {o} must be finite")
-            if joint == source:
-                raise ModelError(f"{full.name}: joint {joint!r} mimics itself")
-            if joint in rule:
-                raise ModelError(f"{full.name}: joint {joint!r} mimics two joints ({rule[joint][0]!r}, {source!r})")
-            rule[joint] = (source, r, o)
-        resolved = {}
-        for joint in rule:  # q_j = r q_s + o, with s itself a mimic joint: follow to the independent one
-            source, r, o = rule[joint]
-            seen = [joint]
-            while source in rule:
-                if source in seen:
-                    raise ModelError(f"{full.name}: mimic joints form a cycle: {' -> '.join(seen + [source])}")
-                seen.append(source)
-                s2, r2, o2 = rule[source]
-                source, r, o = s2, r * r2, r * o2 + o
-            resolved[joint] = (source, r, o)
         dependent = np.zeros(full.nbodies, bool)
         for joint in resolved:
             dependent[body_of[joint]] = True
@@ -108,7 +92,7 @@ class CoupledModel:
             P[full.idx_q[i], col_q[int(full.idx_q[s])]] = r
             offset[full.idx_q[i]] = o
         setattr_(self, "full", full)
-        setattr_(self, "mimic", tuple((j, *resolved[j]) for j in rule))
+        setattr_(self, "mimic", tuple((j, *resolved[j]) for j in resolved))
         for key, a in (("G", G), ("P", P), ("offset", offset), ("independent_q", ind_q), ("independent_v", ind_v)):
             setattr_(self, key, readonly(a, a.dtype))
         setattr_(self, "nq", int(len(ind_q)))
@@ -188,6 +172,37 @@ _TREE_FIELDS = frozenset(set(Model.__slots__) - _BODY_FIELDS - set(CoupledModel.
 class CouplingError(ModelError, AttributeError):
     """A function that does not take mimic couplings was given a :class:`CoupledModel` (an
     ``AttributeError`` too, so that ``hasattr`` and ``getattr`` with a default see no field)."""
+
+
+def follow_chains(name: str, joint_names, mimic) -> dict:
+    """``{joint: (source, multiplier, offset)}`` of the ``mimic`` entries ``(joint, source, r,
+    o)`` (``q_joint = r q_source + o``), in their order, each source followed to its
+    independent joint (a mimic of a mimic: ``q_j = r (r2 q_s + o2) + o``). The multipliers and
+    offsets may be numbers or sympy expressions. ``ModelError`` (naming the model ``name``) for
+    joints not in ``joint_names``, a joint that mimics itself or two joints, and cycles."""
+    known = set(joint_names)
+    rule = {}
+    for joint, source, r, o in mimic:
+        for role, j in (("mimic joint", joint), ("source joint", source)):
+            if j not in known:
+                raise ModelError(f"{name}: {role} {j!r} is not a joint of the model")
+        if joint == source:
+            raise ModelError(f"{name}: joint {joint!r} mimics itself")
+        if joint in rule:
+            raise ModelError(f"{name}: joint {joint!r} mimics two joints ({rule[joint][0]!r}, {source!r})")
+        rule[joint] = (source, r, o)
+    resolved = {}
+    for joint in rule:
+        source, r, o = rule[joint]
+        seen = [joint]
+        while source in rule:
+            if source in seen:
+                raise ModelError(f"{name}: mimic joints form a cycle: {' -> '.join(seen + [source])}")
+            seen.append(source)
+            s2, r2, o2 = rule[source]
+            source, r, o = s2, r * r2, r * o2 + o
+        resolved[joint] = (source, r, o)
+    return resolved
 
 
 def is_coupled(model) -> bool:

@@ -15,8 +15,10 @@ def run_derive(model, args) -> int:
     up to 3 joints), and write the LaTeX document and the C code when asked (``--form
     auto``: ``M``, ``g``, ``tau`` as the straight-line code of the recursions, ``C``
     expanded; ``--form expanded``: every term expanded; see
-    :meth:`.EquationsOfMotion.program`)."""
+    :meth:`.EquationsOfMotion.program`). A model with mimic joints (``--mimic couple``, the
+    default) gives the equations of its independent joints (:mod:`robodyn.symbolic.mimic`)."""
     from ..symbolic.equations import equations_of_motion  # imports sympy
+    from ..symbolic.mimic import rule_text
 
     t0 = time.perf_counter()
     eom = equations_of_motion(model, method=args.method, friction=not args.no_friction)
@@ -24,6 +26,8 @@ def run_derive(model, args) -> int:
     passive = "without" if args.no_friction else "with"
     print(f"robodyn derive {model.name!r}: {eom.n} joints, {args.method.replace('_', '-')} method, "
           f"{passive} the joints' friction and springs (tau_p), derived in {t1 - t0:.2f} s")
+    if eom.model.mimic:
+        print(f"  mimic joints (not coordinates): {', '.join(rule_text(e) for e in eom.model.mimic)}")
     sizes = {name: sum(len(x) for row in p for x in (row if isinstance(row, list) else [row]))
              if isinstance(p, list) else len(p) for name, p in eom.polynomials.items()}
     print("  terms (monomials): " + ", ".join(f"{k} {sizes[k]}" for k in ("M", "C", "g", "T", "U", "tau")))

@@ -15,7 +15,9 @@ DH table with symbols (:func:`from_dh`), joint twists (:func:`from_poe`), links 
 inertial parameters (:func:`with_inertia_symbols`); :mod:`.textbook` has the textbooks'
 robots (``textbook.scara_mls()``, ``elbow_mls()``, ``planar_2r_mls()``); :func:`recursive_dynamics` generates ``M``, ``C v``, ``g``,
 ``tau`` and ``tau_p`` from the recursions without the expanded derivation; :func:`regressor` gives
-``Y(q, v, a)`` with ``tau = Y theta``. This subpackage imports sympy; ``import robodyn`` does not import it.
+``Y(q, v, a)`` with ``tau = Y theta``. A :class:`robodyn.CoupledModel` (mimic joints, :mod:`.mimic`)
+gives the terms of its independent coordinates, as the numeric algorithms'. This subpackage imports
+sympy; ``import robodyn`` does not import it.
 """
 
 from .builder import ModelBuilder

@@ -9,10 +9,12 @@ returns the symbol ``x_k``, so nothing is ever expanded: each step is a few oper
 names of the previous steps. Numbers fold as the recursion runs (sympy's automatic
 evaluation: ``0 * x = 0``, ``1 * x = x``, ``x - x = 0``), so the zeros and ones of the
 geometry, the axes and the inertial parameters cost nothing, and an expression met twice is
-named once. Joint ``k`` enters as ``s_k``, ``c_k`` (revolute) or ``q_k`` (prismatic), as in
-:class:`._ring.TrigRing`. This is the "customised" symbolic evaluation of the recursive
-algorithms of W. Khalil, J.-F. Kleinfinger, "Minimum operations and minimum parameters of the
-dynamic models of tree structure robots", IEEE J. Robotics and Automation 3(6), 1987.
+named once. Coordinate ``k`` enters as ``s_k``, ``c_k`` (revolute) or ``q_k`` (prismatic), as in
+:class:`._ring.TrigRing`, and a mimic joint as the assignments of its ``sin``, ``cos`` or
+``x`` from its source's (:meth:`._ring.VectorAlgebra.couple_joints`). This is the
+"customised" symbolic evaluation of the recursive algorithms of W. Khalil, J.-F. Kleinfinger,
+"Minimum operations and minimum parameters of the dynamic models of tree structure robots",
+IEEE J. Robotics and Automation 3(6), 1987.
 """
 
 from __future__ import annotations
@@ -31,15 +33,17 @@ class Emitter(VectorAlgebra):
     def __init__(self, model: SymbolicModel, rates: bool = True, accelerations: bool = True):
         n = model.nv
         self.model = model
-        self.revolute = [t == "revolute" for t in model.joint_type]
+        self.revolute = [model.joint_type[b] == "revolute" for b in model.independent]
         self.pos = [trig_names(k)[0] if r else model.q[k] for k, r in enumerate(self.revolute)]
         self.cos = [trig_names(k)[1] if r else None for k, r in enumerate(self.revolute)]
+        self.angle = list(model.q)
         self.zero, self.one = sp.S.Zero, sp.S.One
         self.qd = list(model.v) if rates else [self.zero] * n
         self.qdd = list(model.a) if accelerations else [self.zero] * n
         self.assignments = []
         self._names = {}
         self._symbols = sp.numbered_symbols("x", real=True)
+        self.couple_joints()
 
     def reduce(self, e):
         """``e`` itself when it is a number or a (negated) symbol, else the name of an

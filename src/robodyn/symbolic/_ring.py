@@ -3,13 +3,17 @@
 Every quantity of a derivation (placements, velocities, forces, M, C, g, energies) is a
 polynomial over the rationals in these generators:
 
-* ``s_k, c_k`` (``sin q_k``, ``cos q_k``) for a revolute joint ``k``, ``x_k`` (``q_k``) for
-  a prismatic one;
+* ``s_k, c_k`` (``sin q_k``, ``cos q_k``) for a revolute coordinate ``k``, ``x_k`` (``q_k``)
+  for a prismatic one, and ``q_k`` itself for a revolute coordinate that a prismatic mimic
+  joint follows (:mod:`.mimic`; a mimic joint is no coordinate: its ``sin``, ``cos`` or ``x``
+  are polynomials in its source's);
 * ``qd_k`` and ``qdd_k``;
 * the model's parameters: its free symbols, and every non-polynomial piece of its entries
-  (``cos(alpha1)``, ``sqrt(2)``, ``pi``) as an opaque generator.
+  (``cos(alpha1)``, ``sqrt(2)``, ``pi``, a mimic joint's ``cos o``, ``sin o``) as an opaque
+  generator.
 
-Products are reduced with ``c_k^2 = 1 - s_k^2`` (so each ``c_k`` has degree 0 or 1). The
+Products are reduced with ``c_k^2 = 1 - s_k^2`` (so each ``c_k`` has degree 0 or 1), and
+``cos^2 o = 1 - sin^2 o`` for the offsets of the mimic joints. The
 monomials ``s^a`` and ``s^a c`` are a basis of the polynomials in ``sin q, cos q``, so this
 form is canonical: two expressions are equal as functions of ``q`` exactly when their
 reduced polynomials are equal, and no ``simplify`` is ever needed (for the joint angles;
@@ -51,7 +55,72 @@ def trig_names(k: int) -> tuple[sp.Symbol, sp.Symbol]:
 class VectorAlgebra:
     """3-vector and 3 x 3 matrix products on scalars of a derivation, each entry passed
     through ``self.reduce`` (trigonometric reduction in :class:`TrigRing`, a named
-    intermediate in :class:`~._emit.Emitter`)."""
+    intermediate in :class:`~._emit.Emitter`); the joints' values from the coordinates' and
+    the map of joint forces to the coordinates (mimic joints, :mod:`.mimic`).
+
+    The coordinates' scalars are ``pos[k]`` (``sin q_k`` of a revolute coordinate, ``q_k``
+    of a prismatic one), ``cos[k]``, ``angle[k]`` (``q_k`` itself where a prismatic joint
+    follows a revolute coordinate, else None), ``qd[k]``, ``qdd[k]``; :meth:`couple_joints`
+    sets the joints' (one per body), which the recursions read: ``joint_revolute[i]``,
+    ``joint_pos[i]``, ``joint_cos[i]``, ``joint_qd[i]``, ``joint_qdd[i]``."""
+
+    def couple_joints(self) -> None:
+        """The joints' values (class docstring) from the coordinates': those of coordinate
+        ``k`` for its own joint; for a joint ``r q_k + o`` following it, ``sin``, ``cos`` of
+        the sum of angles (:meth:`mimic_angle`), ``r x_k + o`` (prismatic), ``r qd_k``, ``r qdd_k``."""
+        m = self.model
+        self.joint_revolute = [t == "revolute" for t in m.joint_type]
+        self.joint_pos, self.joint_cos, self.joint_qd, self.joint_qdd = [], [], [], []
+        for i, (k, r, o) in enumerate(m.coupling):
+            same = r == 1 and o == 0 and self.joint_revolute[i] == (self.cos[k] is not None)
+            if same:
+                s, c = self.pos[k], self.cos[k]
+            elif self.joint_revolute[i]:
+                s, c = self.mimic_angle(k, r, o)
+            else:
+                s, c = self.reduce(self.const(r) * self.angle[k] + self.const(o)), None
+            self.joint_pos.append(s)
+            self.joint_cos.append(c)
+            self.joint_qd.append(self.qd[k] if r == 1 else self.const(r) * self.qd[k])
+            self.joint_qdd.append(self.qdd[k] if r == 1 else self.const(r) * self.qdd[k])
+
+    def mimic_angle(self, k: int, r, o) -> tuple:
+        """``(sin(r q_k + o), cos(r q_k + o))`` for an integer ``r``: ``sin(j q)``, ``cos(j q)``
+        by ``(j + 1) q = j q + q`` up to ``|r|``, the sign, then the sum with the constant ``o``."""
+        s, c = self.pos[k], self.cos[k]
+        sr, cr = self.zero, self.one
+        for _ in range(abs(int(r))):
+            sr, cr = self.reduce(sr * c + cr * s), self.reduce(cr * c - sr * s)
+        if r < 0:
+            sr = -sr
+        if o != 0:
+            co, so = self.const(sp.cos(o)), self.const(sp.sin(o))
+            sr, cr = self.reduce(sr * co + cr * so), self.reduce(cr * co - sr * so)
+        return sr, cr
+
+    def coordinate_forces(self, f) -> list:
+        """``G^T f`` (nv,): the joint forces ``f`` (one per body) on the coordinates, each
+        times its joint's multiplier (``f`` itself without mimic joints)."""
+        m = self.model
+        if not m.mimic:
+            return list(f)
+        out = [self.zero] * m.nv
+        for i, (k, r, _) in enumerate(m.coupling):
+            out[k] = out[k] + (f[i] if r == 1 else self.const(r) * f[i])
+        return [self.reduce(x) for x in out]
+
+    def coordinate_matrix(self, A) -> list:
+        """``G^T A G`` (nv x nv) of a matrix ``A`` over the joints (nb x nb; ``A`` itself
+        without mimic joints)."""
+        m = self.model
+        if not m.mimic:
+            return A
+        out = [[self.zero] * m.nv for _ in range(m.nv)]
+        for i, (k, r, _) in enumerate(m.coupling):
+            for j, (l, t, _) in enumerate(m.coupling):
+                w = r * t
+                out[k][l] = out[k][l] + (A[i][j] if w == 1 else self.const(w) * A[i][j])
+        return [[self.reduce(x) for x in row] for row in out]
 
     def matvec(self, R, v):
         return [self.reduce(R[r][0] * v[0] + R[r][1] * v[1] + R[r][2] * v[2]) for r in range(3)]
@@ -78,28 +147,49 @@ class TrigRing(VectorAlgebra):
     def __init__(self, model: SymbolicModel):
         n = model.nv
         self.model = model
-        self.revolute = [t == "revolute" for t in model.joint_type]
+        self.revolute = [model.joint_type[b] == "revolute" for b in model.independent]
         pos = [sp.Dummy(f"s{k + 1}") if r else model.q[k] for k, r in enumerate(self.revolute)]
         cos = [sp.Dummy(f"c{k + 1}") for k, r in enumerate(self.revolute) if r]
+        # the angle itself of a revolute coordinate that a prismatic joint follows (x = r q + o)
+        angles = sorted({k for (k, _, _), t in zip(model.coupling, model.joint_type)
+                         if t == "prismatic" and self.revolute[k]})
         exprs = list(model.gravity) + [*model.armature]
         for i in range(model.nbodies):
             exprs += [*model.joint_axis[i], *model.X_tree_R[i], *model.X_tree_p[i], *model.theta[i]]
+        for joint, _, r, o in model.mimic:
+            exprs += [r, o] + ([sp.cos(o), sp.sin(o)] if model.joint_type[model.joint_names.index(joint)] == "revolute"
+                               else [])
         atoms = set()
         for e in exprs:
             atoms |= _nonpolynomial_atoms(e)
         self.atom_dummies = {a: sp.Dummy(f"a{j}") for j, a in enumerate(sorted(atoms, key=sp.default_sort_key))}
         params = sorted(set().union(*(e.free_symbols for e in exprs)) - set(model.q), key=lambda s: s.name)
-        gens = pos + cos + list(model.v) + list(model.a) + params + list(self.atom_dummies.values())
+        gens = (pos + cos + [model.q[k] for k in angles] + list(model.v) + list(model.a) + params
+                + list(self.atom_dummies.values()))
         self.ring = PolyRing(gens, QQ, "lex")
+        g = iter(self.ring.gens)
+        self.pos = [next(g) for _ in range(n)]
+        self.cos = [None] * n
+        for k in range(n):
+            if self.revolute[k]:
+                self.cos[k] = next(g)
+        self.angle = [None if r else self.pos[k] for k, r in enumerate(self.revolute)]
+        for k in angles:
+            self.angle[k] = next(g)
+        self.qd = [next(g) for _ in range(n)]
+        self.qdd = [next(g) for _ in range(n)]
         g = self.ring.gens
-        self.pos = g[:n]
-        ci = iter(g[n:n + len(cos)])
-        self.cos = [next(ci) if r else None for r in self.revolute]
-        self.qd = g[n + len(cos):2 * n + len(cos)]
-        self.qdd = g[2 * n + len(cos):3 * n + len(cos)]
         index = {x: j for j, x in enumerate(g)}
-        # (s index, c index) of each revolute joint, for the reduction c^2 = 1 - s^2
+        # (s index, c index) of each revolute coordinate, for the reduction c^2 = 1 - s^2,
         self.pairs = [(index[self.pos[k]], index[self.cos[k]]) for k in range(n) if self.revolute[k]]
+        # and of the sine and cosine of a mimic joint's offset (constants: cos^2 o = 1 - sin^2 o)
+        where = {d: j for j, d in enumerate(gens)}
+        for joint, _, _, o in model.mimic:
+            so, co = (_nonpolynomial_atoms(f(o)) for f in (sp.sin, sp.cos))
+            if len(so) == len(co) == 1 and model.joint_type[model.joint_names.index(joint)] == "revolute":
+                pair = (where[self.atom_dummies[so.pop()]], where[self.atom_dummies[co.pop()]])
+                if pair not in self.pairs:
+                    self.pairs.append(pair)
         self.qd_index = [index[x] for x in self.qd]
         self.qdd_index = [index[x] for x in self.qdd]
         # back to sympy: s_k -> sin(q_k), c_k -> cos(q_k), atoms back to themselves
@@ -112,6 +202,7 @@ class TrigRing(VectorAlgebra):
         self._cos_dummies = cos
         self._pos_dummies = pos
         self.zero, self.one = self.ring.zero, self.ring.one
+        self.couple_joints()
 
     def _cos_number(self, k: int) -> int:
         return sum(self.revolute[:k])
@@ -186,11 +277,13 @@ class TrigRing(VectorAlgebra):
         return res
 
     def dq(self, p, k: int):
-        """``dp/dq_k``: ``c_k dp/ds_k - s_k dp/dc_k`` (revolute) or ``dp/dx_k`` (prismatic)."""
+        """``dp/dq_k``: ``c_k dp/ds_k - s_k dp/dc_k`` (revolute, plus ``dp/dq_k`` when the angle
+        itself is a generator) or ``dp/dx_k`` (prismatic)."""
         if not self.revolute[k]:
             return p.diff(self.pos[k])
         s, c = self.pos[k], self.cos[k]
-        return self.reduce(p.diff(s) * c - p.diff(c) * s)
+        d = self.reduce(p.diff(s) * c - p.diff(c) * s)
+        return d if self.angle[k] is None else d + p.diff(self.angle[k])
 
     def ddt(self, p):
         """Time derivative along the motion: ``sum_k dp/dq_k qd_k + dp/dqd_k qdd_k``."""

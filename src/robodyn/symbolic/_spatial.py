@@ -15,14 +15,16 @@ def joint_placement(rg: TrigRing, i: int):
     """``(R, p)`` of body ``i`` in its parent: ``X_tree * X_J(q_i)``.
 
     Revolute about the unit axis ``a``: ``R = X_tree_R (a a^T + c (1 - a a^T) + s [a]x)``
-    (Rodrigues), ``p = X_tree_p``; prismatic: ``R = X_tree_R``, ``p = X_tree_p + X_tree_R a x``.
+    (Rodrigues), ``p = X_tree_p``; prismatic: ``R = X_tree_R``, ``p = X_tree_p + X_tree_R a x``,
+    with the joint's ``s, c`` or ``x`` (``rg.joint_pos``, ``rg.joint_cos``: a mimic joint's are
+    those of its source's coordinate, :mod:`.mimic`).
     """
     m = rg.model
     Rt, pt, a = rg.mat(m.X_tree_R[i]), rg.vec(m.X_tree_p[i]), rg.vec(m.joint_axis[i])
-    if not rg.revolute[i]:
+    if not rg.joint_revolute[i]:
         d = rg.matvec(Rt, a)
-        return Rt, [pt[r] + d[r] * rg.pos[i] for r in range(3)]
-    s, c = rg.pos[i], rg.cos[i]
+        return Rt, [pt[r] + d[r] * rg.joint_pos[i] for r in range(3)]
+    s, c = rg.joint_pos[i], rg.joint_cos[i]
     ax = [[rg.zero, -a[2], a[1]], [a[2], rg.zero, -a[0]], [-a[1], a[0], rg.zero]]
     rot = [[a[r] * a[k] * (1 - c) + (c if r == k else rg.zero) + s * ax[r][k] for k in range(3)] for r in range(3)]
     return rg.matmul(Rt, rot), pt
@@ -32,7 +34,7 @@ def motion_subspace(rg: TrigRing, i: int) -> list:
     """``S_i`` (6,) in body ``i``'s frame."""
     a = rg.vec(rg.model.joint_axis[i])
     z = [rg.zero] * 3
-    return z + a if rg.revolute[i] else a + z
+    return z + a if rg.joint_revolute[i] else a + z
 
 
 def motion_act_inv(rg: TrigRing, R, p, m) -> list:

@@ -21,12 +21,13 @@ from ._spatial import force_act, inertia_act, inertia_mul, joint_placement, moti
 
 
 def mass_matrix(rg) -> list:
-    """``M(q)`` (n x n lists of scalars of ``rg``), armature on the diagonal."""
+    """``M(q)`` (n x n lists of scalars of ``rg``), armature on the diagonal; with mimic
+    joints ``G^T M_joints G`` (:mod:`.mimic`)."""
     m = rg.model
     X = [joint_placement(rg, i) for i in range(m.nbodies)]
     S = [motion_subspace(rg, i) for i in range(m.nbodies)]
     Ic = [rg.vec(th) for th in m.theta]
-    M = [[rg.zero] * m.nv for _ in range(m.nv)]
+    M = [[rg.zero] * m.nbodies for _ in range(m.nbodies)]
     for i in reversed(range(m.nbodies)):
         F = inertia_mul(rg, Ic[i], S[i])
         M[i][i] = rg.reduce(rg.dot(S[i], F) + rg.const(m.armature[i]))
@@ -38,4 +39,4 @@ def mass_matrix(rg) -> list:
         par = m.parent[i]
         if par >= 0:
             Ic[par] = [rg.reduce(a + b) for a, b in zip(Ic[par], inertia_act(rg, *X[i], Ic[i]))]
-    return M
+    return rg.coordinate_matrix(M)

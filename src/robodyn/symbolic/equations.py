@@ -21,6 +21,12 @@ accelerations, named as everywhere in robodyn; their symbols print as q-dot, q-d
                  trajectory's potential), T - U
     tau  (n,)    M a + C v + g + tau_p (as robodyn.rnea)
 
+A model with mimic joints (a :class:`robodyn.CoupledModel`, or a :class:`SymbolicModel` with
+``mimic``; :mod:`.mimic`) has the terms of its independent coordinates q1..qn, as the numeric
+algorithms': ``M = G^T M_full G``, ``tau = G^T tau_full(P q + offset, G v, G a)``, the mimic
+joints' armature, friction and springs through ``G^T``, and ``C`` the Christoffel matrix of
+this ``M``.
+
 ``friction=False`` (as ``robodyn.rnea(..., friction=False)``) leaves the passive elements out:
 ``tau_p`` is zero, ``U`` has no spring energy and ``tau = M a + C v + g`` (the armature stays
 in ``M``, as ``rnea``'s ``armature=True``). ``dU/dq = g + K (q - q_ref)``: the springs' force is
@@ -49,7 +55,7 @@ from .._deprecated import renamed_attribute
 from . import codegen, lagrange, newton_euler
 from ._ring import TrigRing, readable_numbers
 from ._terms import GeneratedCode, check_form, check_term, signature
-from .model import SymbolicModel, from_model, passive_torque, spring_energy
+from .model import SymbolicModel, from_model, passive_forces, spring_energy
 from .recursive import RECURSIONS, recursive_program, tau_description
 
 METHODS = {"lagrange": lagrange.derive, "newton_euler": newton_euler.derive}
@@ -117,7 +123,7 @@ class EquationsOfMotion(GeneratedCode):
         self._poly["L"] = result["T"] - result["U"]
         self._poly["tau_p"] = [rg.zero] * n
         # the terms outside the ring: passive forces and spring energy (symbols q_k, v_k)
-        tau_p = [passive_torque(model, k) if friction else sp.Integer(0) for k in range(n)]
+        tau_p = passive_forces(model) if friction else [sp.Integer(0)] * n
         U_spring = spring_energy(model) if friction else sp.Integer(0)
         self._extra = {"tau_p": tau_p, "tau": tau_p, "U": [U_spring], "L": [-U_spring]}
         if method == "newton_euler":
@@ -287,7 +293,8 @@ class EquationsOfMotion(GeneratedCode):
 
 def equations_of_motion(model, method: str = "lagrange", *, friction: bool = True) -> EquationsOfMotion:
     """Closed-form equations of motion of ``model`` (a :class:`robodyn.Model` with revolute
-    and prismatic joints on a fixed base, or a :class:`SymbolicModel`).
+    and prismatic joints on a fixed base, a :class:`robodyn.CoupledModel` of one (mimic joints:
+    the equations of its independent coordinates, module docstring), or a :class:`SymbolicModel`).
 
     ``method="lagrange"``: Euler-Lagrange equations of ``T = qd^T M qd / 2`` and the gravity
     potential ``-sum m_i g . p_ci`` (:mod:`.lagrange`); ``method="newton_euler"``: the

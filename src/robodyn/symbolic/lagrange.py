@@ -9,9 +9,12 @@ The body Jacobians follow the tree outwards (``J_i = X_i^-1 J_parent + S_i``), s
 multiplies by the trigonometric terms of one joint only. The time derivative is
 ``d/dt = sum_j qd_j d/dq_j + qdd_j d/dqd_j``. ``M`` and ``g`` are read off ``tau`` (its
 ``qdd`` coefficients and its part without ``qd`` and ``qdd``); ``C`` is the Christoffel
-matrix of ``M``. Reference: M. W. Spong, S. Hutchinson, M. Vidyasagar, *Robot Modeling and
-Control*, Wiley 2006, sections 7.1-7.3; R. M. Murray, Z. Li, S. S. Sastry, *A Mathematical
-Introduction to Robotic Manipulation*, CRC 1994, section 4.2.
+matrix of ``M``. With mimic joints (:mod:`.mimic`) ``M = G^T M_joints G`` and ``U`` is that
+of the joints' placements in the coordinates, so that ``tau`` is the Euler-Lagrange equations
+of the independent coordinates, ``G^T tau_joints``. Reference: M. W. Spong, S. Hutchinson,
+M. Vidyasagar, *Robot Modeling and Control*, Wiley 2006, sections 7.1-7.3; R. M. Murray,
+Z. Li, S. S. Sastry, *A Mathematical Introduction to Robotic Manipulation*, CRC 1994,
+section 4.2.
 """
 
 from __future__ import annotations
@@ -21,9 +24,10 @@ from ._spatial import inertia_mul, joint_placement, motion_act_inv, motion_subsp
 
 
 def mass_matrix(rg: TrigRing) -> list:
-    """``M = sum_i J_i^T I_i J_i + diag(armature)`` (n x n lists of ring polynomials)."""
-    m, n = rg.model, rg.model.nv
-    M = [[rg.zero] * n for _ in range(n)]
+    """``M = G^T (sum_i J_i^T I_i J_i + diag(armature)) G`` (n x n lists of ring polynomials;
+    ``J_i`` over the joints, ``G`` the identity without mimic joints)."""
+    m, nb = rg.model, rg.model.nbodies
+    M = [[rg.zero] * nb for _ in range(nb)]
     J = []
     for i in range(m.nbodies):
         R, p = joint_placement(rg, i)
@@ -37,11 +41,11 @@ def mass_matrix(rg: TrigRing) -> list:
             for b, Jb in cols.items():
                 if b <= a:
                     M[a][b] = M[a][b] + rg.dot(Jb, f)
-    for a in range(n):
+    for a in range(nb):
         M[a][a] = M[a][a] + rg.const(m.armature[a])
         for b in range(a):
             M[b][a] = M[a][b]
-    return M
+    return rg.coordinate_matrix(M)
 
 
 def derive(rg: TrigRing) -> dict:

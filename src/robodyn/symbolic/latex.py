@@ -4,7 +4,8 @@ Joint symbols print as ``q_1``, ``\\dot{q}_1``, ``\\ddot{q}_1``; ``sin q_1`` and
 as ``s_1`` and ``c_1`` (defined at the top of the document), which keeps the formulas
 of a small robot readable. The passive joint forces ``tau_p`` (friction and springs) print
 with sympy's ``\\operatorname{sign}`` (or ``\\tanh``); the document has their section and
-their term in the equation of motion when the model has some.
+their term in the equation of motion when the model has some. A model with mimic joints lists
+them with their coordinate ``r q_k + o`` (:mod:`.mimic`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from __future__ import annotations
 import sympy as sp
 
 from ._ring import readable_numbers
+from .model import joint_motion
 
 _DESCRIPTION = {
     "M": "Mass matrix $M(q)$",
@@ -68,11 +70,20 @@ def term_latex(eom, name: str) -> str:
     return "\\begin{align*}\n" + " \\\\\n".join(rows) + "\n\\end{align*}"
 
 
+def _text(name: str) -> str:
+    """A name in LaTeX text (underscores escaped)."""
+    return name.replace("_", "\\_")
+
+
 def document(eom) -> str:
     """A complete LaTeX document: the model, the notation and every term."""
     m = eom.model
     passive = any(x != 0 for x in eom.tau_p)  # the section and the term only when there are some
-    joints = ", ".join(f"{n} ({t})" for n, t in zip(m.joint_names, m.joint_type))
+    joints = ", ".join(f"{_text(m.joint_names[b])} ({m.joint_type[b]})" for b in m.independent)
+    if m.mimic:  # each mimic joint's coordinate r q_k + o
+        joints += "; mimic joints " + ", ".join(
+            f"{_text(m.joint_names[i])} ({m.joint_type[i]}) at ${_tex(eom, joint_motion(m, i)[0])}$"
+            for i in range(m.nbodies) if i not in m.independent)
     params = ", ".join(f"${sp.latex(s)}$" for s in eom.parameters) or "none (numeric model)"
     notation = ", ".join(f"$s_{{{k + 1}}} = \\sin q_{{{k + 1}}}$, $c_{{{k + 1}}} = \\cos q_{{{k + 1}}}$"
                          for k in range(eom.n) if eom.ring.revolute[k])
@@ -86,7 +97,7 @@ def document(eom) -> str:
         r"\begin{document}",
         r"\maketitle",
         rf"Derived by \texttt{{robodyn.symbolic}} ({eom.method.replace('_', '-')} method). "
-        rf"{eom.n} joints: {joints.replace('_', chr(92) + '_')}. Parameters: {params}.",
+        rf"{eom.n} joints: {joints}. Parameters: {params}.",
         "",
         (r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) + \tau_p(q, \dot q) = \tau \]" if passive
          else r"\[ M(q)\,\ddot q + C(q, \dot q)\,\dot q + g(q) = \tau \]"),

@@ -20,6 +20,11 @@ Three ways to get one:
 * :func:`with_inertia_symbols`: any of them with the inertial parameters replaced by the
   named symbols ``m1, mx1, my1, mz1, Ixx1, Ixy1, Iyy1, Ixz1, Iyz1, Izz1, m2, ...``.
 
+Mimic joints (:mod:`.mimic`): ``mimic`` lists ``(joint, source, multiplier, offset)``, the
+joint following its source as ``q_joint = multiplier q_source + offset`` (the couplings of
+:class:`robodyn.CoupledModel`, which :func:`from_model` converts); ``q``, ``v``, ``a`` are then
+the symbols of the independent joints only (``nv`` of them, ``nbodies`` bodies).
+
 Per joint the model carries, as the numeric one, the passive elements: ``armature`` (on the
 diagonal of ``M``), viscous ``damping`` ``b``, ``coulomb`` friction ``Fc`` and a joint spring of
 ``stiffness`` ``K`` about ``spring_reference`` ``q_ref``, with ``coulomb_smoothing`` ``eps``
@@ -44,7 +49,9 @@ import warnings
 
 from .._deprecated import renamed_attribute, renamed_keywords
 from .. import joints as J
+from ..coupling import is_coupled
 from ..errors import ModelError, RobodynWarning
+from .mimic import resolve as resolve_mimic, rule_text
 
 JOINT_TYPES = ("revolute", "prismatic")
 PARAMETER_NAMES = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
@@ -132,21 +139,40 @@ def passive_value(x, what: str, nonnegative: bool) -> sp.Expr:
     return e
 
 
-def passive_torque(model: "SymbolicModel", k: int) -> sp.Expr:
-    """The passive force of joint ``k`` (0-based) opposed by its actuator:
+def joint_motion(model: "SymbolicModel", i: int) -> tuple[sp.Expr, sp.Expr]:
+    """``(q_i, qd_i)`` of body ``i``'s joint in the model's symbols: ``(q_k, qd_k)`` of an
+    independent joint, ``(r q_k + o, r qd_k)`` of a mimic joint following coordinate ``k``."""
+    k, r, o = model.coupling[i]
+    return r * model.q[k] + o, r * model.v[k]
+
+
+def passive_torque(model: "SymbolicModel", i: int) -> sp.Expr:
+    """The passive force of body ``i``'s joint (0-based) opposed by its actuator:
     ``damping qd + coulomb sgn(qd) + stiffness (q - spring_reference)`` with ``sgn = sign``
     when ``coulomb_smoothing`` is 0 and ``tanh(qd / coulomb_smoothing)`` otherwise (the numeric
-    ``robodyn.joint_kernels.passive_torque``); zero coefficients fold away."""
-    q, qd, eps = model.q[k], model.v[k], model.coulomb_smoothing
+    ``robodyn.joint_kernels.passive_torque``), at the joint's ``(q, qd)``
+    (:func:`joint_motion`); zero coefficients fold away."""
+    (q, qd), eps = joint_motion(model, i), model.coulomb_smoothing
     sgn = sp.sign(qd) if eps == 0 else sp.tanh(qd / eps)
-    return (model.damping[k] * qd + model.coulomb[k] * sgn
-            + model.stiffness[k] * (q - model.spring_reference[k]))
+    return (model.damping[i] * qd + model.coulomb[i] * sgn
+            + model.stiffness[i] * (q - model.spring_reference[i]))
+
+
+def passive_forces(model: "SymbolicModel") -> list:
+    """The passive forces on the coordinates, ``tau_p = G^T tau_p,joints`` (nv,): each
+    joint's :func:`passive_torque` times its multiplier, on its coordinate (a mimic joint's
+    friction and spring act on its source, as in the numeric ``rnea`` of a coupled model)."""
+    out = [sp.Integer(0)] * model.nv
+    for i, (k, r, _) in enumerate(model.coupling):
+        out[k] = out[k] + r * passive_torque(model, i)
+    return out
 
 
 def spring_energy(model: "SymbolicModel") -> sp.Expr:
-    """The energy stored in the joint springs, ``sum_k stiffness_k (q_k - spring_reference_k)^2 / 2``."""
-    return sum((K * (q - r) ** 2 / 2 for K, q, r in zip(model.stiffness, model.q, model.spring_reference)),
-               sp.Integer(0))
+    """The energy stored in the joint springs, ``sum_i stiffness_i (q_i - spring_reference_i)^2 / 2``
+    (``q_i`` the joint's coordinate, :func:`joint_motion`)."""
+    return sum((model.stiffness[i] * (joint_motion(model, i)[0] - model.spring_reference[i]) ** 2 / 2
+                for i in range(model.nbodies)), sp.Integer(0))
 
 
 @dataclass(frozen=True)
@@ -160,7 +186,11 @@ class SymbolicModel:
     joint: ``armature`` (rotor inertia on the diagonal of ``M``), ``damping``, ``coulomb``,
     ``stiffness`` and ``spring_reference`` (the passive forces, module docstring; empty tuples
     mean zeros). ``coulomb_smoothing``: the smoothing velocity of the Coulomb friction (0:
-    ``sign``). ``gravity`` (3 x 1, world frame). ``q``, ``v``, ``a``: the joint symbols.
+    ``sign``). ``gravity`` (3 x 1, world frame). ``mimic``: ``(joint, source, multiplier,
+    offset)`` couplings (:mod:`.mimic`; kept with each source followed to its independent
+    joint). ``q``, ``v``, ``a``: the symbols of the coordinates, one per independent joint
+    (``nv``); ``independent`` (nv,): their bodies; ``coupling[i] = (k, r, o)``: body ``i``'s
+    joint is ``r q_k + o`` (``(k, 1, 0)`` for an independent joint).
     """
 
     parent: tuple
@@ -179,9 +209,12 @@ class SymbolicModel:
     stiffness: tuple = ()
     spring_reference: tuple = ()
     coulomb_smoothing: sp.Expr = 0
+    mimic: tuple = ()
     q: tuple = field(init=False)
     v: tuple = field(init=False)
     a: tuple = field(init=False)
+    coupling: tuple = field(init=False)
+    independent: tuple = field(init=False)
 
     def __post_init__(self):
         nb = len(self.parent)
@@ -211,9 +244,19 @@ class SymbolicModel:
         set_("coulomb_smoothing", passive_value(self.coulomb_smoothing, "coulomb_smoothing", True))
         set_("link_names", tuple(self.link_names) or tuple(f"link{i + 1}" for i in range(nb)))
         set_("joint_names", tuple(self.joint_names) or tuple(f"joint{i + 1}" for i in range(nb)))
-        set_("q", tuple(sp.Symbol(f"q{k + 1}", real=True) for k in range(nb)))
-        set_("v", tuple(sp.Symbol(f"qd{k + 1}", real=True) for k in range(nb)))
-        set_("a", tuple(sp.Symbol(f"qdd{k + 1}", real=True) for k in range(nb)))
+        rules = []
+        for e in self.mimic:
+            if len(e) != 4:
+                raise ModelError(f"{self.name}: mimic entries are (joint, source, multiplier, offset), got {e!r}")
+            rules.append((e[0], e[1], passive_value(e[2], f"mimic joint {e[0]!r}: multiplier", False),
+                          passive_value(e[3], f"mimic joint {e[0]!r}: offset", False)))
+        for what, value in zip(("mimic", "coupling", "independent"),
+                               resolve_mimic(self.name, self.joint_names, self.joint_type, rules)):
+            set_(what, value)
+        n = len(self.independent)
+        set_("q", tuple(sp.Symbol(f"q{k + 1}", real=True) for k in range(n)))
+        set_("v", tuple(sp.Symbol(f"qd{k + 1}", real=True) for k in range(n)))
+        set_("a", tuple(sp.Symbol(f"qdd{k + 1}", real=True) for k in range(n)))
 
     @property
     def nbodies(self) -> int:
@@ -221,7 +264,8 @@ class SymbolicModel:
 
     @property
     def nv(self) -> int:
-        return len(self.parent)
+        """The number of coordinates: the independent joints (all joints without ``mimic``)."""
+        return len(self.independent)
 
     def inertial_parameters(self) -> list:
         """All inertial parameters (10 * nbodies), body after body."""
@@ -236,6 +280,8 @@ class SymbolicModel:
                 syms |= x.free_symbols
             for t in (*self.theta[i], self.armature[i], *(getattr(self, f)[i] for f, _ in PASSIVE_FIELDS)):
                 syms |= t.free_symbols
+        for _, _, r, o in self.mimic:
+            syms |= r.free_symbols | o.free_symbols
         syms |= self.coulomb_smoothing.free_symbols
         return sorted(syms, key=lambda s: s.name)
 
@@ -257,8 +303,9 @@ class SymbolicModel:
     qdd = renamed_attribute("qdd", "a")
 
     def __repr__(self) -> str:
+        rules = f", mimic: {', '.join(rule_text(e) for e in self.mimic)}" if self.mimic else ""
         return (f"SymbolicModel {self.name!r}: {self.nbodies} bodies, joints "
-                f"{''.join('R' if t == 'revolute' else 'P' for t in self.joint_type)}, "
+                f"{''.join('R' if t == 'revolute' else 'P' for t in self.joint_type)}{rules}, "
                 f"parameters {[s.name for s in self.parameters()]}")
 
 
@@ -270,9 +317,15 @@ def from_model(model) -> SymbolicModel:
     (module docstring): geometry, inertias, gravity and the joints' armature, damping,
     Coulomb friction (with its smoothing) and springs. Revolute and prismatic joints on a
     fixed base only. Stribeck friction, when the model has it, is not in the closed forms
-    (a :class:`robodyn.RobodynWarning` says so)."""
+    (a :class:`robodyn.RobodynWarning` says so). A :class:`robodyn.CoupledModel` gives the
+    model of its full tree with its mimic joints (:mod:`.mimic`): the coordinates ``q1..qn``
+    are its independent joints, as the numeric algorithms' (``M = G^T M_full G``,
+    ``tau = G^T tau_full(P q + offset, G v, G a)``); couplings that are not trigonometric
+    polynomials raise :class:`robodyn.ModelError`."""
     if isinstance(model, SymbolicModel):
         return model
+    if is_coupled(model):  # the full tree, its mimic joints following their sources
+        return from_model(model.full).replace(mimic=tuple((j, s, exact(r), exact(o)) for j, s, r, o in model.mimic))
     for kind in (J.SPHERICAL, J.HELICAL, J.PLANAR):
         if np.any(model.joint_type == kind):
             raise ModelError(f"model {model.name!r} has a {J.NAMES[kind]} joint; robodyn.symbolic derives "

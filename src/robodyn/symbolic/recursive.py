@@ -4,7 +4,7 @@
     tau(q, v, a), g(q) = tau(q, 0, 0), C_v(q, v) = tau(q, v, 0) without gravity
                   recursive Newton-Euler algorithm (:mod:`.newton_euler`)
     tau_p(q, v)   the joints' passive forces (no recursion: one expression per joint,
-                  :func:`.model.passive_torque`), added to ``tau`` unless ``friction=False``
+                  :func:`.model.passive_forces`), added to ``tau`` unless ``friction=False``
 
 run once on symbols (:class:`._emit.Emitter`) and written as straight-line code, one
 assignment per intermediate scalar: ``sin q_k`` and ``cos q_k`` once each, then the entries
@@ -25,7 +25,7 @@ from __future__ import annotations
 from . import codegen, crba, newton_euler
 from ._emit import Emitter
 from ._terms import GeneratedCode, check_form, check_term, signature
-from .model import SymbolicModel, from_model, passive_torque
+from .model import SymbolicModel, from_model, passive_forces
 
 # the terms of the generated code by the recursions, and how each is evaluated
 RECURSIONS = {
@@ -50,7 +50,7 @@ def recursive_program(model: SymbolicModel, name: str, friction: bool = True) ->
     ``tau`` and ``tau_p`` with the joints' passive forces unless ``friction=False``."""
     name = check_term(name, RECURSIONS)
     n = model.nv
-    passive = [passive_torque(model, k) if friction else 0 for k in range(n)]
+    passive = passive_forces(model) if friction else [0] * n
     if name == "M":
         em = Emitter(model)
         outputs, shape = [x for row in crba.mass_matrix(em) for x in row], (n, n)
@@ -99,8 +99,10 @@ class RecursiveDynamics(GeneratedCode):
 
 def recursive_dynamics(model, *, friction: bool = True) -> RecursiveDynamics:
     """Fast generated code for ``M``, ``C_v``, ``g``, ``tau`` and ``tau_p`` of ``model`` (a
-    :class:`robodyn.Model` with revolute and prismatic joints on a fixed base, or a
-    :class:`SymbolicModel`) by the recursions, without the expanded derivation::
+    :class:`robodyn.Model` with revolute and prismatic joints on a fixed base, a
+    :class:`robodyn.CoupledModel` of one (the terms of its independent coordinates,
+    :mod:`.mimic`), or a :class:`SymbolicModel`) by the recursions, without the expanded
+    derivation::
 
         rec = rd.symbolic.recursive_dynamics(rd.models.load("panda"))
         M = rec.to_numba("M")          # M(q): (..., 7, 7), one state in about a microsecond

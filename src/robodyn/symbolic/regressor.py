@@ -6,7 +6,10 @@ body origin, robodyn's order; :func:`.model.with_inertia_symbols`). The model's 
 are made symbols, ``tau`` is derived exactly (:mod:`.newton_euler` or :mod:`.lagrange`), and
 ``Y_ij = d tau_i / d theta_j``. Armature, friction and joint springs are not inertial parameters and
 are not in ``Y``: ``rnea(model, q, v, a, friction=False, armature=False) = Y theta`` (the
-numeric :func:`robodyn.regressor` has columns for them).
+numeric :func:`robodyn.regressor` has columns for them). With mimic joints (a
+:class:`robodyn.CoupledModel`, :mod:`.mimic`) ``Y = G^T Y_full(P q + offset, G v, G a)``, n rows
+for the independent coordinates and the 10 columns of every body of the full tree, as
+``robodyn.regressor(coupled, q, v, a)`` without its extra columns.
 Reference: W. Khalil, E. Dombre, *Modeling, Identification and Control of Robots*, Hermes
 2002, chapter 12.
 """
@@ -67,8 +70,8 @@ class Regressor:
 
 
 def regressor(model, method: str = "newton_euler") -> Regressor:
-    """The regressor of ``model`` (numeric or symbolic; its inertial parameters are replaced
-    by the symbols ``m1, mx1, ...``, its armature, friction and springs left out)."""
+    """The regressor of ``model`` (numeric, coupled or symbolic; its inertial parameters are
+    replaced by the symbols ``m1, mx1, ...``, its armature, friction and springs left out)."""
     if method not in METHODS:
         raise ValueError(f"method must be one of {list(METHODS)}, got {method!r}")
     sm = with_inertia_symbols(from_model(model)).rigid()
