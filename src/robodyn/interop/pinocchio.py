@@ -52,7 +52,7 @@ import warnings
 import numpy as np
 
 from .. import joints as J
-from ..errors import ModelError, RobodynWarning
+from ..errors import ModelError, RobodynWarning, user_stacklevel
 from ..coupling import CoupledModel, is_coupled
 from ..model import Model, check_inertial_parameters, inertia_about_origin
 
@@ -236,7 +236,7 @@ def _mimic_to_pinocchio(pin, model: CoupledModel, pm):
         pm = pin.transformJointIntoMimic(pm, s + 1, i + 1, float(r), float(o))
     if lost:
         warnings.warn(f"to_pinocchio: a Pinocchio mimic joint has no damping, friction, armature or spring: not "
-                      f"converted for {', '.join(lost)}", RobodynWarning, stacklevel=3)
+                      f"converted for {', '.join(lost)}", RobodynWarning, stacklevel=user_stacklevel())
     return pm
 
 
@@ -441,8 +441,8 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model | CoupledMode
     )
     if not mimic:
         return full
-    return CoupledModel(full, [(pm.names[j], pm.names[_mimic_source(pm, j)], pm.joints[j].extract().scaling,
-                                pm.joints[j].extract().offset) for j in mimic])
+    rules = [(j, pm.joints[j].extract()) for j in mimic]
+    return CoupledModel(full, [(pm.names[j], pm.names[_mimic_source(pm, j)], m.scaling, m.offset) for j, m in rules])
 
 
 # ---------------------------------------------------------------------------------------

@@ -168,7 +168,7 @@ def load_mjcf(source, *, physical: str = "error", mimic: str = "couple") -> Mode
         reader.children(world, "world", (np.eye(3), np.zeros(3)), "main", world=True)
     b = ModelBuilder(root.get("model", "mujoco"), gravity=gravity, source=name, physical=physical)
     reader.build(b)
-    couplings = _joint_equalities(root, doc, defaults, reader.named, ignored)
+    couplings = _joint_equalities(root, doc, reader, ignored)
     notes = []
     if couplings and mimic == "independent":
         notes.append(f"joint equalities loaded as independent joints (mimic='independent'): "
@@ -185,22 +185,19 @@ def load_mjcf(source, *, physical: str = "error", mimic: str = "couple") -> Mode
     return CoupledModel(model, couplings) if couplings and mimic == "couple" else model
 
 
-def _joint_equalities(root, doc: _Doc, defaults, named: dict, ignored: Counter) -> list[tuple]:
+def _joint_equalities(root, doc: _Doc, reader: _Bodies, ignored: Counter) -> list[tuple]:
     """The linear joint equalities of ``<equality>`` as mimic couplings ``(joint, source,
     multiplier, offset)``: MuJoCo's ``y - y0 = a0 + a1 (x - x0) + a2 (x - x0)^2 + ...`` (``y``
     joint1, ``x`` joint2, ``y0``, ``x0`` their ``ref``; robodyn's ``q`` is ``qpos``) with
     ``a2 = a3 = a4 = 0`` is ``q_y = a1 q_x + (y0 + a0 - a1 x0)``. Inactive ones, those without
     ``joint2`` (a joint locked at a value), polynomial ones and the other kinds (``connect``,
     ``weld``, ``tendon``, ``flex``) are counted in ``ignored`` (``equality/<kind>``)."""
-    out = []
+    out, named = [], reader.named
     for group in root.findall("equality"):
         for e in group:
             if not isinstance(e.tag, str):
                 continue
-            cls = e.get("class", "main")
-            if cls not in defaults:
-                raise ModelError(f"{doc.where(e)}: unknown default class {cls!r}")
-            a = _override(defaults[cls].get("equality", {}), e.attrib)
+            a = reader.attrs(e, "main", "equality")
             if e.tag != "joint" or doc.flag(e, a, "active", "true") == "false":
                 ignored[f"equality/{e.tag}" + (" (inactive)" if e.tag == "joint" else "")] += 1
                 continue
@@ -381,11 +378,13 @@ class _Bodies:
         self.named: dict[str, tuple[str, float]] = {}  # joint named in the file -> (MJCF type, ref in q units)
 
     # attributes with defaults -----------------------------------------------------------
-    def attrs(self, elem, cls: str) -> dict:
+    def attrs(self, elem, cls: str, tag: str | None = None) -> dict:
+        """``elem``'s attributes over the defaults of its class (``cls`` unless it names one)
+        for its tag (``tag``: another, as ``equality`` for every kind of equality)."""
         cls = elem.get("class", cls)
         if cls not in self.defaults:
             raise ModelError(f"{self.doc.where(elem)}: unknown default class {cls!r}")
-        return _override(self.defaults[cls].get(elem.tag, {}), elem.attrib)
+        return _override(self.defaults[cls].get(tag or elem.tag, {}), elem.attrib)
 
     def rotation(self, elem, a) -> np.ndarray:
         doc, given = self.doc, [k for k in _ORIENTATIONS if k in a]

@@ -385,13 +385,10 @@ def _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, *, co
                          "are held as bilateral constraints, which the set-valued friction does not combine with; "
                          "load the robot with mimic='independent'")
     user = () if constraints is None else (constraints if isinstance(constraints, (list, tuple)) else (constraints,))
-    if contacts is not None:
-        if user:
-            raise ValueError("constraints: not with contacts (bilateral constraints and contacts in one solve are "
-                             "not supported yet); model the contacts or the constraints alone")
+    if contacts is not None:  # the tree's checks refuse the caller's constraints with contacts
         q0f, v0f, law, _ = coupled.full_tree_problem(model, q0, v0, controller, ())
         traj = _simulate_tree(model.full, q0f, v0f, duration, dt, law, integrator, contacts=contacts,
-                              constraints=None, stiction=False, coupling=model, **options)
+                              constraints=user, stiction=False, coupling=model, **options)
         return coupled.reduced_trajectory(model, traj, False)
     q0f, v0f, law, held = coupled.full_tree_problem(model, q0, v0, controller, user)
     traj = simulate(model.full, q0f, v0f, duration, dt, law, integrator, constraints=held, **options)
