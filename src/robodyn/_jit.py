@@ -57,8 +57,32 @@ VEC = _types.Array(_types.float64, 1, "C")
 MAT = _types.Array(_types.float64, 2, "C")
 MODEL_INTS = _types.Array(_types.int64, 2, "C")
 MODEL_PACKED = _types.Array(_types.float64, 1, "C")
+INTS = _types.Array(_types.int64, 1, "C")
 
 
 def fast(*argtypes):
     """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only."""
     return njit([_types.int64(*argtypes)], **_CALLED)
+
+
+class _FirstCall:
+    """A :func:`fast` kernel compiled at its first call (see :func:`fast_lazy`)."""
+
+    __slots__ = ("dispatcher", "signature", "ready", "__wrapped__")
+
+    def __init__(self, func, signature):
+        self.dispatcher, self.signature, self.ready = njit(**_CALLED)(func), signature, False
+        self.__wrapped__ = func
+
+    def __call__(self, *args):
+        if not self.ready:
+            self.dispatcher.compile(self.signature)
+            self.dispatcher.disable_compile()  # other argument types raise TypeError, as fast()'s
+            self.ready = True
+        return self.dispatcher(*args)
+
+
+def fast_lazy(*argtypes):
+    """Decorator: :func:`fast`, compiled (or loaded from the disk cache) at the first call."""
+    signature = _types.int64(*argtypes)
+    return lambda func: _FirstCall(func, signature)

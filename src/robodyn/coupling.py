@@ -30,7 +30,7 @@ coupled model are those of the independent joints (a mimic joint's own limits ar
 
 from __future__ import annotations
 
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
@@ -51,7 +51,7 @@ class CoupledModel:
     """
 
     __slots__ = ("full", "mimic", "G", "P", "offset", "nq", "nv", "independent_q", "independent_v",
-                 "joint_names", "lower", "upper", "velocity_limit", "effort_limit")
+                 "joint_names", "lower", "upper", "velocity_limit", "effort_limit", "tables")
 
     def __init__(self, full: Model, mimic: Sequence[tuple]):
         if not isinstance(full, Model):
@@ -100,6 +100,7 @@ class CoupledModel:
         setattr_(self, "joint_names", tuple(n for n in full.joint_names if n not in resolved))
         for key in ("lower", "upper", "velocity_limit", "effort_limit"):
             setattr_(self, key, readonly(getattr(full, key)[ind_v]))
+        setattr_(self, "tables", CouplingTables.of(G, P, offset))
 
     def __setattr__(self, key, value):
         raise AttributeError("CoupledModel is immutable")
@@ -118,10 +119,8 @@ class CoupledModel:
         if key in _BODY_FIELDS:
             return getattr(self.full, key)
         if key in _TREE_FIELDS:  # indexed by the full tree's coordinates: code that reads them does not map
-            raise CouplingError(f"{self.full.name}: this function does not take a model with mimic couplings "
-                                f"(CoupledModel: {key!r} is the full tree's, not of the independent coordinates) "
-                                f"yet; pass model.full (the mimic joints as independent joints) or load the file "
-                                f"with mimic='independent'")
+            raise not_supported(self, "this function", f"CoupledModel: {key!r} is the full tree's, not of the "
+                                                       "independent coordinates")
         raise AttributeError(f"'CoupledModel' object has no attribute {key!r}")
 
     @property
@@ -169,9 +168,38 @@ _BODY_FIELDS = frozenset((
 _TREE_FIELDS = frozenset(set(Model.__slots__) - _BODY_FIELDS - set(CoupledModel.__slots__))
 
 
+class CouplingTables(NamedTuple):
+    """The coupling in the compiled kernels' form. ``G`` and ``P`` have one entry per row (an
+    independent coordinate's 1, or a mimic joint's multiplier in its source's column), so::
+
+        v_full[k] = dof_scale[k] v[dof_map[k]],     q_full[k] = q_scale[k] q[q_map[k]] + q_offset[k]
+
+    ``ints`` (2 + nv_full + nq_full,) int64 ``[nq, nv, dof_map, q_map]``; ``floats``
+    (nv_full + 2 nq_full,) ``[dof_scale, q_scale, q_offset]`` (writeable, as the kernels'
+    signatures take them; nothing writes them). The compiled maps are in
+    :mod:`robodyn.coupling_kernels`."""
+
+    ints: np.ndarray
+    floats: np.ndarray
+
+    @classmethod
+    def of(cls, G: np.ndarray, P: np.ndarray, offset: np.ndarray) -> "CouplingTables":
+        dof_map, q_map = np.abs(G).argmax(axis=1), np.abs(P).argmax(axis=1)
+        dof_scale, q_scale = G[np.arange(G.shape[0]), dof_map], P[np.arange(P.shape[0]), q_map]
+        ints = np.concatenate([[P.shape[1], G.shape[1]], dof_map, q_map]).astype(np.int64)
+        return cls(ints, np.concatenate([dof_scale, q_scale, offset]).astype(np.float64))
+
+
 class CouplingError(ModelError, AttributeError):
     """A function that does not take mimic couplings was given a :class:`CoupledModel` (an
     ``AttributeError`` too, so that ``hasattr`` and ``getattr`` with a default see no field)."""
+
+
+def not_supported(model: CoupledModel, what: str, why: str) -> "CouplingError":
+    """The error of a function (``what``) that does not take a model with mimic couplings yet."""
+    return CouplingError(f"{model.full.name}: {what} does not take a model with mimic couplings ({why}) yet; pass "
+                         f"model.full (the mimic joints as independent joints) or load the file with "
+                         f"mimic='independent'")
 
 
 def follow_chains(name: str, joint_names, mimic) -> dict:

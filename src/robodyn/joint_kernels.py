@@ -7,8 +7,9 @@ from __future__ import annotations
 import numpy as np
 
 from ._jit import inline
-from .layout import COULOMB, DAMPING, JOINT_CONSTANTS, SPRING_REF, STIFFNESS, STRIBECK, STRIBECK_RATE, XTREE_P, XTREE_R
-from .joints import HELICAL, PLANAR, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
+from .layout import (COULOMB, DAMPING, IQ, JOINT_CONSTANTS, JTYPE, SPRING_REF, STIFFNESS, STRIBECK, STRIBECK_RATE,
+                     XTREE_P, XTREE_R)
+from .joints import HELICAL, NQ, PLANAR, PRISMATIC, QUAT_TOL, REVOLUTE, SPHERICAL
 from .sincos import sincos
 from .spatial import rotation_from_quaternion
 
@@ -155,3 +156,10 @@ def passive_torque_dv(dofs, eps, vk, k):
         x = vk * r
         out -= 2.0 * x * r * fx * np.exp(-x * x) * s
     return out
+
+
+@inline
+def nq_of(ints):
+    """Length of the configuration vector of the model whose kernel table is ``ints``."""
+    nb = ints.shape[0]
+    return 0 if nb == 0 else ints[nb - 1, IQ] + NQ[ints[nb - 1, JTYPE]]

@@ -13,17 +13,11 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import inline
-from ..layout import BODY_COLUMNS, DOF_COLUMNS, IQ, IV, JTYPE, NDOF, PARAMS_SIZE
-from ..joints import NQ
+from ..layout import BODY_COLUMNS, DOF_COLUMNS, IV, NDOF, PARAMS_SIZE
 from ._lazy import is_lazy
 from ._workspace import view
-
-
-@inline
-def nq_of(ints):
-    """Length of the configuration vector of the model whose kernel table is ``ints``."""
-    nb = ints.shape[0]
-    return 0 if nb == 0 else ints[nb - 1, IQ] + NQ[ints[nb - 1, JTYPE]]
+from .driver import chunks
+from .status import NO_WRENCH, OK, raise_for_coupled
 
 
 @inline
@@ -205,3 +199,37 @@ def as_batch(a: np.ndarray) -> np.ndarray:
 
 def unflatten(out: np.ndarray, batch: tuple) -> np.ndarray:
     return out if batch == () else out.reshape(batch + out.shape[1:])
+
+
+NO_WRENCHES = np.zeros((0, 6))  # ``fext`` of a single-state kernel call without external wrenches (never read)
+
+
+def coupled_call(model, one, batch, sizes, third: str, q, v, x, f_ext, frame: str, friction: bool,
+                 armature: bool, check: bool, out, what: str) -> np.ndarray:
+    """A per-state algorithm ``(q, v, x) -> (nv,)`` of a :class:`~robodyn.coupling.CoupledModel`
+    (``x`` named ``third``: ``a`` or ``tau``) by its compiled single-state kernel ``one(ints,
+    packed, cints, cfloats, q, v, x, fext, fcode, check, out)`` (a contiguous float64 state
+    without wrenches goes straight to it) or its batch kernel ``batch`` (workspace ``sizes``),
+    the full tree's tables and the coupling's; errors name the caller's arrays (``what``)."""
+    full, tables, k = model.full, model.tables, model.full.kernel
+    packed = k.packed[bool(friction), bool(armature)]
+    if f_ext is None and frame in WRENCH_FRAMES:
+        res = fast_out(out, (model.nv,))
+        try:  # one state of contiguous float64 vectors (the dispatcher raises TypeError otherwise)
+            if one(k.ints, packed, tables.ints, tables.floats, q, v, x, NO_WRENCHES, NO_WRENCH, check, res) == OK:
+                return res
+        except TypeError:
+            pass
+    shape, xs = states(model, q=q, v=v, **{third: x})
+    F, fcode = body_wrenches(full, f_ext, shape, frame)
+    res, result = output(out, shape, (model.nv,), xs)
+    if shape == ():
+        status = one(k.ints, packed, tables.ints, tables.floats, xs["q"], xs["v"], xs[third],
+                     np.array(F, order="C") if fcode >= 0 else NO_WRENCHES, fcode, check, res)
+    else:
+        B = xs["q"].shape[0]
+        status = np.empty(B, dtype=np.int64)
+        batch((k.ints, k.body, k.dofs[(bool(friction), bool(armature))], k.params[True], tables.ints, tables.floats,
+               xs["q"], xs["v"], xs[third], F, fcode, check, res), sizes, status, chunks(B))
+    raise_for_coupled(model, status, xs, what)
+    return result

@@ -31,13 +31,20 @@ NV_ARGS = ("v", "a", "tau", "a_known", "tau_known", "v_ref", "a_ref")
 
 def is_lazy(x) -> bool:
     """True for a Dask collection (anything with a task graph)."""
-    return hasattr(type(x), "__dask_graph__")
+    t = type(x)
+    return t not in _EAGER and hasattr(t, "__dask_graph__")
+
+
+_EAGER = frozenset((np.ndarray, type(None), float, int, bool, list, tuple, str, np.float64))  # never lazy: quick
 
 
 def any_lazy(*xs) -> bool:
     """True when one of ``xs`` is a Dask collection: the public functions then return
     :func:`deferred` results."""
-    return any(is_lazy(x) for x in xs)
+    for x in xs:
+        if is_lazy(x):
+            return True
+    return False
 
 
 def _core(model, name: str) -> tuple:

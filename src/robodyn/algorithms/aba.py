@@ -37,18 +37,18 @@ from numba import boolean
 from .._deprecated import renamed_keyword
 from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
-from ..joint_kernels import passive_torque, local_placement
+from ..joint_kernels import local_placement, nq_of, passive_torque
 from ..joints import FREE
 from ..spatial import (congruence_shift, cross_into, force_cross, inertia_matrix, inertia_rotated, matvec6, mirror_upper,
                        momentum, motion_cross, rotate6, shift_motion, shifted_motion, unshift_force, upper_triangle,
                        wrench_to_aligned)
-from ..coupling import into, is_coupled
+from ..coupling import is_coupled
 from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import fits, nq_of, unpack
+from ._inputs import fits, unpack
 from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
 from .driver import batch_kernel, chunks
 
@@ -573,18 +573,18 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba()")
+    if is_coupled(model) and not any_lazy(q, v, tau, f_ext):  # mimic joints: M a = tau - h, independent coordinates
+        return coupled.run_aba(model, q, v, tau, f_ext, frame, friction, armature, check_finite, out)
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
-            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+            k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
             if _aba_packed(k.ints, k.packed[friction, armature], q, v, tau, check_finite, qdd) == OK:
                 return qdd
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
     if any_lazy(q, v, tau, f_ext):
         return deferred(aba, locals())
-    if is_coupled(model):  # mimic joints: M a = tau - h in the independent coordinates
-        return into(out, coupled.forward_dynamics(model, q, v, tau, f_ext, frame, friction, armature, check_finite)[0])
     k = model.kernel
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)

@@ -25,6 +25,7 @@ import numpy as np
 from numba import boolean
 
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from ..joint_kernels import nq_of
 from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
 from ..coupling import expand_q, expand_v, into, is_coupled, reduce_matrix
@@ -33,7 +34,7 @@ from . import _inputs
 from .status import raise_for_status
 from .crba import world_state
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import fits, nq_of, unpack
+from ._inputs import fits, unpack
 from .status import OK, WRONG_SIZE, finite2, result_status
 from .driver import batch_kernel, chunks
 

@@ -10,15 +10,102 @@ recursion does not apply to a coupled tree (a mimic joint moves with a joint els
 tree), so the forward dynamics factorises ``M`` (Cholesky; ``M`` is positive definite when
 the full tree's is). Reference: Featherstone, RBDA (2008), section 8.3 (constraints that
 remove degrees of freedom: ``G`` there), Pinocchio's mimic joints.
+
+:func:`run_aba` is the compiled forward dynamics (``robodyn.aba`` of a coupled model, per
+state: the full tree's CRBA and RNEA, the reduction, a dense Cholesky); the NumPy functions
+below give the factor ``L`` to the derivatives, the inverse mass matrix and the hybrid dynamics.
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import boolean, int64
 
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast_lazy, inline, kernel
 from ..coupling import expand_q, expand_v, reduce_force, reduce_matrix
-from .crba import crba
-from .rnea import rnea
+from ..coupling_kernels import expand_positions, expand_velocity, reduce_square, reduce_vector
+from ..joint_kernels import nq_of
+from . import _inputs
+from ._inputs import fits, unpack
+from ._workspace import view
+from .crba import crba, crba_one
+from .crba import workspace as crba_workspace
+from .dense import backward, cholesky as factorise, forward
+from .driver import batch_kernel
+from .rnea import rnea, rnea_one
+from .rnea import workspace as rnea_workspace
+from .status import (NONFINITE, NOT_POSITIVE_DEFINITE, OK, WRONG_SIZE, finite, raise_not_positive_definite,
+                     result_status)
+
+
+@kernel
+def aba_workspace(nb, nqf, nvf, nv):
+    """Scratch of :func:`aba_coupled_state`: the CRBA's, the RNEA's, and a buffer for the full
+    tree's ``q, v, 0, h, M`` and the reduced ``M`` (nq_full + 3 nv_full + nv_full^2 + nv^2)."""
+    return crba_workspace(nb, nvf), rnea_workspace(nb), np.empty(nqf + 3 * nvf + nvf * nvf + nv * nv)
+
+
+@inline
+def aba_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, tau, fext, fcode, check, qdd, ws):
+    """Forward dynamics of a model with mimic couplings, one state: ``qdd = M^-1 (tau - h)``
+    (nv,) with ``M = G^T M_full G = L L^T`` and ``h = G^T rnea_full(P q + o, G v, 0)`` (the
+    full tree in ``ints, body, dofs, params``, the coupling in ``cints, cfloats``). Returns a
+    status (``NOT_POSITIVE_DEFINITE`` when ``M`` is not)."""
+    cws, rws, buf = ws
+    nqf, nvf, nv = nq_of(ints), dofs.shape[0], cints[1]
+    qf, vf, zero = view(buf, 0, (nqf,)), view(buf, nqf, (nvf,)), view(buf, nqf + nvf, (nvf,))
+    hf, Mf = view(buf, nqf + 2 * nvf, (nvf,)), view(buf, nqf + 3 * nvf, (nvf, nvf))
+    M = view(buf, nqf + 3 * nvf + nvf * nvf, (nv, nv))
+    if not (q.shape[0] == cints[0] and v.shape[0] == nv and tau.shape[0] == nv):
+        return WRONG_SIZE
+    if check and not (finite(q) and finite(v) and finite(tau)):
+        return NONFINITE
+    expand_positions(cints, cfloats, q, qf)
+    expand_velocity(cints, cfloats, v, vf)
+    for k in range(nvf):
+        zero[k] = 0.0
+    status = crba_one(ints, body, dofs, qf, check, Mf, cws)
+    if status == OK:
+        status = rnea_one(ints, body, dofs, params, qf, vf, zero, fext, fcode, check, hf, rws)
+    if status != OK:
+        return status
+    reduce_square(cints, cfloats, Mf, M)
+    reduce_vector(cints, cfloats, hf, qdd)
+    for i in range(nv):
+        qdd[i] = tau[i] - qdd[i]
+    if not factorise(M):
+        return NOT_POSITIVE_DEFINITE
+    forward(M, qdd)
+    backward(M, qdd)
+    return result_status(check, finite(qdd))
+
+
+@inline
+def aba_coupled_at(args, s, ws):
+    """:func:`aba_coupled_state` of state ``s`` of a batch (``F``: one row per state, or one for all)."""
+    ints, body, dofs, params, cints, cfloats, Q, V, TAU, F, fcode, check, QDD = args
+    return aba_coupled_state(ints, body, dofs, params, cints, cfloats, Q[s], V[s], TAU[s],
+                             F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws)
+
+
+_aba_coupled_batch = batch_kernel(aba_coupled_at, aba_workspace)
+
+
+@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
+def _aba_coupled_one(ints, packed, cints, cfloats, q, v, tau, fext, fcode, check, qdd):
+    """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
+    body, dofs, params, _ = unpack(ints, packed)
+    if not fits(qdd, cints[1], q, v, tau):
+        return WRONG_SIZE
+    return aba_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, tau, fext, fcode, check, qdd,
+                             aba_workspace(ints.shape[0], nq_of(ints), dofs.shape[0], cints[1]))
+
+
+def run_aba(model, q, v, tau, f_ext, frame: str, friction: bool, armature: bool, check: bool, out=None):
+    """:func:`robodyn.aba` of a :class:`~robodyn.coupling.CoupledModel` (compiled, per state)."""
+    sizes = (model.nbodies, model.full.nq, model.full.nv, model.nv)
+    return _inputs.coupled_call(model, _aba_coupled_one, _aba_coupled_batch, sizes, "tau", q, v, tau, f_ext, frame,
+                                friction, armature, check, out, "aba")
 
 
 def mass_matrix(model, q, armature: bool, check_finite: bool) -> np.ndarray:
@@ -39,9 +126,7 @@ def cholesky(M: np.ndarray, model, what: str) -> np.ndarray:
     try:
         return np.linalg.cholesky(M)
     except np.linalg.LinAlgError:
-        raise ValueError(f"{what}: the mass matrix of {model.name!r} in its independent coordinates is not "
-                         "positive definite, so the forward dynamics is undefined; give the bodies the joints "
-                         "move mass and inertia (or armature)") from None
+        raise_not_positive_definite(model, what)
 
 
 def solve(L: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -16,16 +16,18 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, fast_lazy, inline, kernel
+from ..joint_kernels import nq_of
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
-from ..coupling import expand_q, into, is_coupled, reduce_matrix
+from ..coupling import is_coupled
+from ..coupling_kernels import expand_positions, reduce_square
 from ._lazy import any_lazy, deferred
 from . import _inputs
-from .status import raise_for_status
+from .status import raise_for_coupled, raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import fits, nq_of, unpack
-from .status import OK, WRONG_SIZE, finite, result_status
+from ._inputs import fits, unpack
+from .status import NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
 from .driver import batch_kernel, chunks
 from .kinematics import poses_checked, world_motion_subspace
 
@@ -133,6 +135,77 @@ def _crba_packed(ints, packed, q, check, M):
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
+@kernel
+def coupled_workspace(nb, nqf, nvf):
+    """Scratch of :func:`crba_coupled_state`: the CRBA's, and a buffer for the full tree's
+    ``q`` and ``M`` (nq_full + nv_full^2)."""
+    return workspace(nb, nvf), np.empty(nqf + nvf * nvf)
+
+
+@inline
+def crba_coupled_state(ints, body, dofs, cints, cfloats, q, check, M, ws):
+    """Mass matrix of a model with mimic couplings (``robodyn.coupling``), one state:
+    ``M = G^T M_full(P q + o) G`` (nv, nv), the full tree in ``ints, body, dofs``, the
+    coupling in ``cints, cfloats``. Returns a status."""
+    cws, buf = ws
+    nqf, nvf = nq_of(ints), dofs.shape[0]
+    qf, Mf = view(buf, 0, (nqf,)), view(buf, nqf, (nvf, nvf))
+    if q.shape[0] != cints[0]:
+        return WRONG_SIZE
+    if check and not finite(q):
+        return NONFINITE
+    expand_positions(cints, cfloats, q, qf)
+    status = crba_one(ints, body, dofs, qf, check, Mf, cws)
+    if status != OK:
+        return status
+    reduce_square(cints, cfloats, Mf, M)
+    return result_status(check, finite2(M))
+
+
+@inline
+def crba_coupled_at(args, s, ws):
+    """:func:`crba_coupled_state` of state ``s`` of a batch."""
+    ints, body, dofs, cints, cfloats, Q, check, MM = args
+    return crba_coupled_state(ints, body, dofs, cints, cfloats, Q[s], check, MM[s], ws)
+
+
+_crba_coupled_batch = batch_kernel(crba_coupled_at, coupled_workspace)
+
+
+@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, boolean, MAT)
+def _crba_coupled_one(ints, packed, cints, cfloats, q, check, M):
+    """One state of a coupled model."""
+    body, dofs, _, _ = unpack(ints, packed)
+    if not fits(M, cints[1], q, q, q):
+        return WRONG_SIZE
+    return crba_coupled_state(ints, body, dofs, cints, cfloats, q, check, M,
+                              coupled_workspace(ints.shape[0], nq_of(ints), dofs.shape[0]))
+
+
+def run_coupled(model, q, armature: bool, check: bool, out=None) -> np.ndarray:
+    """:func:`crba` of a :class:`~robodyn.coupling.CoupledModel` (compiled: the full tree's
+    CRBA and the congruence ``G^T M G``, per state)."""
+    tables, k = model.tables, model.full.kernel
+    packed = k.packed[False, bool(armature)]
+    M = _inputs.fast_out(out, (model.nv, model.nv))
+    try:  # one state, a contiguous float64 vector (the dispatcher raises TypeError otherwise)
+        if _crba_coupled_one(k.ints, packed, tables.ints, tables.floats, q, check, M) == OK:
+            return M
+    except TypeError:
+        pass
+    batch, x = _inputs.states(model, q=q)
+    M, result = _inputs.output(out, batch, (model.nv, model.nv), x)
+    if batch == ():
+        status = _crba_coupled_one(k.ints, packed, tables.ints, tables.floats, x["q"], check, M)
+    else:
+        B = x["q"].shape[0]
+        status = np.empty(B, dtype=np.int64)
+        _crba_coupled_batch((k.ints, k.body, k.dofs[(False, bool(armature))], tables.ints, tables.floats, x["q"],
+                             check, M), (model.nbodies, model.full.nq, model.full.nv), status, chunks(B))
+    raise_for_coupled(model, status, x, "crba")
+    return result
+
+
 def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.ndarray | None = None) -> np.ndarray:
     """Joint-space inertia (mass) matrix ``M(q)``, full and symmetric.
 
@@ -144,18 +217,17 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
+    if is_coupled(model) and not any_lazy(q):  # G^T M_full G
+        return run_coupled(model, q, armature, check_finite, out)
     M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
-        k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+        k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
         if _crba_packed(k.ints, k.packed[False, armature], q, check_finite, M) == OK:
             return M
     except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or armature not bool)
         pass
     if any_lazy(q):
         return deferred(crba, locals())
-    if is_coupled(model):  # G^T M_full G
-        M = crba(model.full, expand_q(model, q), armature=armature, check_finite=check_finite)
-        return into(out, reduce_matrix(model, M))
     batch, x = _inputs.states(model, q=q)
     dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)

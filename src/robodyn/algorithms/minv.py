@@ -36,7 +36,7 @@ import numpy as np
 
 from .._jit import core, inline, kernel
 from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_END
-from ..joint_kernels import local_placement
+from ..joint_kernels import local_placement, nq_of
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
                        upper_triangle)
 from ..coupling import is_coupled
@@ -44,7 +44,6 @@ from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
-from ._inputs import nq_of
 from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from .aba import aligned_placement, articulated_inertia, joint_acceleration, joint_inertia

@@ -17,20 +17,21 @@ Pass 2 (leaves to root)::
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean
+from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, fast_lazy, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
-from ..joint_kernels import body_placement, passive_torque
+from ..joint_kernels import body_placement, nq_of, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
                        wrench_to_local)
-from ..coupling import expand_q, expand_v, into, is_coupled, reduce_force
+from ..coupling import is_coupled
+from ..coupling_kernels import expand_positions, expand_velocity, reduce_vector
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
-from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import fits, nq_of, unpack
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
+from ._inputs import fits, unpack
 from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
 from .kinematics import world_placement
 from .driver import batch_kernel, chunks
@@ -207,6 +208,65 @@ def _rnea_packed(ints, packed, q, v, a, check, tau):
     return rnea_state(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
+@kernel
+def coupled_workspace(nb, nqf, nvf):
+    """Scratch of :func:`rnea_coupled_state`: the RNEA's, and a buffer for the full tree's
+    ``q, v, a, tau`` (nq_full + 3 nv_full)."""
+    return workspace(nb), np.empty(nqf + 3 * nvf)
+
+
+@inline
+def rnea_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, a, fext, fcode, check, tau, ws):
+    """Inverse dynamics of a model with mimic couplings (``robodyn.coupling``), one state:
+    ``tau = G^T rnea_full(P q + o, G v, G a)`` (nv,), the full tree in ``ints, body, dofs,
+    params``, the coupling in ``cints, cfloats`` (``CouplingTables``). Returns a status."""
+    rws, buf = ws
+    nqf, nvf = nq_of(ints), dofs.shape[0]
+    qf, vf = view(buf, 0, (nqf,)), view(buf, nqf, (nvf,))
+    af, tf = view(buf, nqf + nvf, (nvf,)), view(buf, nqf + 2 * nvf, (nvf,))
+    if not (q.shape[0] == cints[0] and v.shape[0] == cints[1] and a.shape[0] == cints[1]):
+        return WRONG_SIZE
+    if check and not (finite(q) and finite(v) and finite(a)):
+        return NONFINITE
+    expand_positions(cints, cfloats, q, qf)
+    expand_velocity(cints, cfloats, v, vf)
+    expand_velocity(cints, cfloats, a, af)
+    status = rnea_one(ints, body, dofs, params, qf, vf, af, fext, fcode, check, tf, rws)
+    if status != OK:
+        return status
+    reduce_vector(cints, cfloats, tf, tau)
+    return result_status(check, finite(tau))
+
+
+@inline
+def rnea_coupled_at(args, s, ws):
+    """:func:`rnea_coupled_state` of state ``s`` of a batch (``F`` as in :func:`rnea_at`)."""
+    ints, body, dofs, params, cints, cfloats, Q, V, A, F, fcode, check, TAU = args
+    return rnea_coupled_state(ints, body, dofs, params, cints, cfloats, Q[s], V[s], A[s],
+                              F[s if F.shape[0] > 1 else 0], fcode, check, TAU[s], ws)
+
+
+_rnea_coupled_batch = batch_kernel(rnea_coupled_at, coupled_workspace)
+
+
+@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
+def _rnea_coupled_one(ints, packed, cints, cfloats, q, v, a, fext, fcode, check, tau):
+    """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
+    body, dofs, params, _ = unpack(ints, packed)
+    if not fits(tau, cints[1], q, v, a):
+        return WRONG_SIZE
+    return rnea_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, a, fext, fcode, check, tau,
+                              coupled_workspace(ints.shape[0], nq_of(ints), dofs.shape[0]))
+
+
+def run_coupled(model, q, v, a, f_ext, frame: str, friction: bool, armature: bool, check: bool, out=None):
+    """:func:`rnea` of a :class:`~robodyn.coupling.CoupledModel` (compiled: the full tree's
+    RNEA between the coupling's maps, per state)."""
+    sizes = (model.nbodies, model.full.nq, model.full.nv)
+    return _inputs.coupled_call(model, _rnea_coupled_one, _rnea_coupled_batch, sizes, "a", q, v, a, f_ext, frame,
+                                friction, armature, check, out, "rnea")
+
+
 def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=True, what="rnea", report=None,
         out=None):
     """RNEA on checked inputs ``x = {"q", "v", "a"}`` (see ``_inputs.states``) into ``out``
@@ -264,20 +324,18 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea()")
+    if is_coupled(model) and not any_lazy(q, v, a, f_ext):  # tau = G^T tau_full(E(q), G v, G a)
+        return run_coupled(model, q, v, a, f_ext, frame, friction, armature, check_finite, out)
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         tau = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks sizes and values
         try:
-            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+            k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
             if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
     if any_lazy(q, v, a, f_ext):
         return deferred(rnea, locals())
-    if is_coupled(model):  # tau = G^T tau_full(E(q), G v, G a)
-        tau = rnea(model.full, expand_q(model, q), expand_v(model, v), expand_v(model, a, "a"), f_ext, frame,
-                   friction=friction, armature=armature, check_finite=check_finite)
-        return into(out, reduce_force(model, tau))
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)

@@ -55,14 +55,14 @@ from numba import boolean
 
 from .._deprecated import renamed_keyword
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
-from ..joint_kernels import passive_torque_dv
+from ..joint_kernels import nq_of, passive_torque_dv
 from ..layout import ARMATURE, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
                        motion_cross, wrench_to_local)
 from ..coupling import expand_q, expand_v, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
-from ._inputs import fits, nq_of, unpack
+from ._inputs import fits, unpack
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from .crba import world_state
 from .driver import batch_kernel, chunks

@@ -4,7 +4,8 @@ Every kernel returns a status per state: ``OK``, ``NONFINITE`` for NaN/Inf in an
 ``BAD_QUATERNION`` for a free joint's quaternion farther than ``joints.QUAT_TOL`` from unit
 norm (near-unit ones are normalised), ``WRONG_SIZE`` for arrays of the wrong length (the
 single-state fast paths), ``NONFINITE_RESULT`` when the inputs are finite but the result
-overflowed, or ``i + 1`` for a failure at body ``i`` (a singular articulated inertia).
+overflowed, ``NOT_POSITIVE_DEFINITE`` for the mass matrix of a model with mimic couplings in
+its independent coordinates, or ``i + 1`` for a failure at body ``i`` (a singular articulated inertia).
 :func:`raise_for_status` turns a failure into a ``ValueError`` that says what and where. The
 checks run inside the kernels, where they cost nanoseconds; ``check_finite=False`` skips the
 NaN/Inf checks of inputs and results. No public function returns NaN or Inf from finite
@@ -23,6 +24,7 @@ NONFINITE = -1
 BAD_QUATERNION = -2
 WRONG_SIZE = -3
 NONFINITE_RESULT = -4
+NOT_POSITIVE_DEFINITE = -5  # a coupled model's reduced mass matrix (see ``raise_for_coupled``)
 
 # Constant arguments of the compiled per-state functions, as NumPy scalars: a Python literal
 # (``-1``, ``True``) in a call from compiled code makes Numba compile a separate copy of the
@@ -124,6 +126,29 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
                 )
         raise AssertionError("kernel reported a bad quaternion that is not there")
     return code
+
+
+def raise_for_coupled(model, status, arrays: dict, what: str) -> int:
+    """:func:`raise_for_status` of a kernel of a model with mimic couplings
+    (``robodyn.coupling``): its inputs are the independent coordinates, checked there; a bad
+    quaternion is found in the full tree's configuration (free and spherical joints are never
+    mimic joints, so its entries are the caller's)."""
+    if type(status) is not int:
+        bad = np.flatnonzero(status)
+        status = int(status[bad[0]]) if bad.size else OK
+    if status == BAD_QUATERNION:
+        return raise_for_status(model.full, status, {"q": arrays["q"] @ model.P.T + model.offset}, what)
+    if status == NOT_POSITIVE_DEFINITE:
+        raise_not_positive_definite(model, what)
+    return raise_for_status(model, status, arrays, what)
+
+
+def raise_not_positive_definite(model, what: str):
+    """Raise the ``ValueError`` of a coupled model whose mass matrix in its independent
+    coordinates is not positive definite (a mimic joint that moves no mass, say)."""
+    raise ValueError(f"{what}: the mass matrix of {model.name!r} in its independent coordinates is not "
+                     "positive definite, so the forward dynamics is undefined; give the bodies the joints "
+                     "move mass and inertia (or armature)")
 
 
 def raise_singular(model, bad: int, what: str, consequence: str = "so the forward dynamics is undefined") -> None:

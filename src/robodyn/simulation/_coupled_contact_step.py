@@ -23,7 +23,7 @@ from .._jit import core, kernel
 from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import NONFINITE_RESULT, OK
-from ..contact.solver import backward, cholesky, forward
+from ..algorithms.dense import backward, cholesky, forward
 from ._contact_step import (contact_forces, contact_rows, contact_velocity, dynamics_terms, moving_frame_terms,
                             next_state, pair_workspace)
 
