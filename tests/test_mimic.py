@@ -352,7 +352,7 @@ def test_functions_without_couplings_say_so():
     with pytest.raises(AttributeError, match="no attribute 'nonsense'"):
         _ = model.nonsense
     with pytest.raises(rd.ModelError, match=say):
-        rd.rollout(model, np.stack([q, q]), q * 0, 0.01, 0.001)
+        rd.inertia_bounds(model)
 
 
 # -- URDF files ---------------------------------------------------------------------------
@@ -550,17 +550,82 @@ def test_simulation_with_constraints_and_wrenches_on_a_coupled_model():
     assert np.abs(tip - tip[0]).max() < 1e-6
 
 
-def test_simulation_refuses_stiction_on_a_coupled_model():
+def test_contacts_with_constraints_are_refused_on_a_coupled_model():
     model = MODELS[0]
     q0 = rd.random.random_configuration(model, rng_for("refuse"))
-    with pytest.raises(ValueError, match="stiction with mimic couplings.*mimic='independent'"):
-        rd.simulate(model, q0, np.zeros(model.nv), 0.01, 0.001, stiction=True)
     from robodyn.contact import Contacts, Plane, Sphere
 
     touch = Contacts([Sphere(model.nbodies - 1, 0.05)], surfaces=[Plane(height=0.0)])
     with pytest.raises(ValueError, match="constraints: not with contacts"):
         rd.simulate(model, q0, np.zeros(model.nv), 0.01, 0.001, contacts=touch,
                     constraints=rd.CouplingConstraint(*model.joint_names[:2], 1.0))
+
+
+def _box_friction(W, b, bound, sweeps=20000):
+    """``|f| <= bound`` complementary to ``b - W f`` by projected Gauss-Seidel (the test's own)."""
+    f = np.zeros(b.shape[0])
+    for _ in range(sweeps):
+        for k in range(f.shape[0]):
+            f[k] = np.clip(f[k] + (b[k] - W[k] @ f) / W[k, k], -bound[k], bound[k])
+    return f
+
+
+def test_stiction_of_a_coupled_model_is_its_own_friction_step():
+    """Every dof of the tree with dry friction (mimic joints' included) resists the coupled
+    model's coordinates: the step below, written here in the independent coordinates (the dry
+    friction box of coordinate i is sum_k |G[k, i]| F_k), is the simulation's."""
+    model = MODELS[0]
+    full = model.full.replace(coulomb=np.linspace(1.0, 12.0, model.full.nv), stribeck=np.full(model.full.nv, 0.3),
+                              stribeck_velocity=np.full(model.full.nv, 0.05), damping=np.full(model.full.nv, 0.2))
+    model = rd.CoupledModel(full, model.mimic)
+    dry = rd.CoupledModel(full.replace(coulomb=np.zeros(full.nv), stribeck=np.zeros(full.nv)), model.mimic)
+    q0 = rd.random.random_configuration(model, rng_for("stiction"))
+    dt, steps = 2e-3, 60
+    traj = rd.simulate(model, q0, np.zeros(model.nv), steps * dt, dt, stiction=True)
+    q, v = q0.copy(), np.zeros(model.nv)
+    absG = np.abs(model.G)
+    for s in range(steps):
+        v_free = v + dt * rd.aba(dry, q, v, np.zeros(model.nv))
+        W = dt * np.linalg.inv(rd.crba(model, q))
+        vf = model.G @ v
+        bound = absG.T @ (full.coulomb + full.stribeck * np.exp(-(vf / full.stribeck_velocity) ** 2))
+        f = _box_friction(W, v_free, bound)
+        assert_rel(traj.joint_friction[s], f, 1e-7, f"friction at step {s}")
+        v = v_free - W @ f
+        v[np.abs(f) < bound] = 0.0
+        q = rd.integrate(model, q, dt * v)
+        assert_rel(traj.v[s + 1], v, 1e-7, f"velocity at step {s + 1}")
+        assert_rel(traj.q[s + 1], q, 1e-9, f"configuration at step {s + 1}")
+    assert np.any(traj.v[-1] == 0.0) and np.any(traj.v[-1] != 0.0), "some joints stick, others slide"
+    qf = rd.coupling.expand_q(model, traj.q)
+    for joint, source, r, o in model.mimic:  # the couplings hold
+        i, k = (full.idx_q[full.body_joint_names.index(n)] for n in (joint, source))
+        assert_rel(qf[:, i], r * qf[:, k] + o, 1e-12)
+
+
+PENDULUM = """<robot name="pendulum">
+  <link name="base"/><link name="arm">{arm}</link><link name="hand">{hand}</link>
+  <joint name="shoulder" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 1 0"/></joint>
+  <joint name="wrist" type="continuous"><parent link="arm"/><child link="hand"/><origin xyz="0.4 0 0"/>
+    <axis xyz="0 1 0"/><dynamics friction="{friction}"/><mimic joint="shoulder" multiplier="2"/></joint>
+</robot>"""
+
+
+@pytest.mark.parametrize("margin,sticks", [(1.01, True), (0.99, False)])
+def test_a_mimic_joints_friction_holds_its_source_with_the_multiplier(margin, sticks):
+    """The only dry friction is the wrist's, a mimic of the shoulder with multiplier 2: the
+    shoulder holds still while gravity's torque on it is below twice the wrist's friction."""
+    parts = dict(arm=_INERTIAL.format(c="0.2 0 0", m=1.0, i=0.01), hand=_INERTIAL.format(c="0.1 0 0", m=0.5, i=0.005))
+    q0 = np.array([0.3])
+    g = rd.gravity(rd.load_urdf(PENDULUM.format(friction=0.0, **parts)), q0)[0]
+    model = rd.load_urdf(PENDULUM.format(friction=margin * abs(g) / 2.0, **parts))
+    traj = rd.simulate(model, q0, np.zeros(1), 0.2, 1e-3, stiction=True)
+    if sticks:
+        assert np.all(traj.v == 0.0) and np.all(traj.q == q0)
+        assert_rel(traj.joint_friction[-1], [-g], 1e-9, "the friction holds the robot (M a = -g - f = 0)")
+    else:
+        assert np.abs(traj.v[-1, 0]) > 1e-3
+        assert_rel(np.abs(traj.joint_friction[-1]), [margin * abs(g)], 1e-6, "sliding: the full box")
 
 
 _INERTIAL = '<inertial><origin xyz="{c}"/><mass value="{m}"/><inertia ixx="{i}" iyy="{i}" izz="{i}" ixy="0.0002" ' \

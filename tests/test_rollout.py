@@ -125,3 +125,63 @@ def test_bad_input_is_refused_and_a_failing_rollout_named():
     fast[1, 3:] = 1e200  # only rollout 1 spins so fast that its gyroscopic torque overflows
     with pytest.raises(ValueError, match=r"rollout 1: simulate at t = 0: the result is not finite"):
         rd.rollout(BOX, q0, fast, 0.1, 1e-3, contacts=BOX_CONTACTS)
+
+
+# -- models with mimic couplings -------------------------------------------------------------
+def _coupled_runs():
+    from test_mimic import MODELS
+
+    from robodyn.contact import Sphere
+    from robodyn.control import ComputedTorque, PointToPoint
+
+    for index in (0, 1, 3):  # fixed base; floating base; floating with a spherical joint
+        model = MODELS[index]
+        rng = np.random.default_rng(index)
+        q0 = np.stack([rd.random.random_configuration(model, rng) for _ in range(2)])
+        contacts = Contacts([Sphere(i, 0.05) for i in range(1, model.nbodies)], surfaces=[Plane(height=-0.4)])
+        laws = [None] if index == 3 else [None, JointPD(model, q0[0], 5.0, 1.0)]
+        if index == 0:
+            laws += [PDGravity(model, q0[0], kp=10.0, kd=2.0),
+                     ComputedTorque(model, PointToPoint(q0[0], q0[1], 0.1), kp=20.0, kd=5.0)]
+        for law in laws:
+            yield pytest.param(model, q0, contacts, law, id=f"{model.name}-{type(law).__name__}")
+
+
+@pytest.mark.parametrize("model,q0,contacts,law", list(_coupled_runs()))
+def test_rollouts_of_a_coupled_model_are_its_simulations(model, q0, contacts, law):
+    """A :class:`rd.CoupledModel` rolls out as ``simulate`` steps it with contacts (its full
+    tree on the coupling, the compiled controller in the independent coordinates, equal to its
+    Python call)."""
+    v0 = np.random.default_rng(5).standard_normal(model.nv)
+    R = rd.rollout(model, q0, v0, 0.15, 2e-3, law, contacts=contacts)
+    assert R.q.shape == (2, 76, model.nq) and R.tau.shape == (2, 76, model.nv)
+    for b in range(2):
+        traj = rd.simulate(model, q0[b], v0, 0.15, 2e-3, law, contacts=contacts, progress=False)
+        for key in ("q", "v", "a", "tau", "contact_force", "contact_distance"):
+            np.testing.assert_array_equal(getattr(R, key)[b], getattr(traj, key), err_msg=key)
+    if law is not None:  # the compiled law is the controller's own call
+        t = 0.06
+        k = int(round(t / 2e-3))
+        q, v = R.q[0, k], R.v[0, k]
+        np.testing.assert_allclose(R.tau[0, k], law(t, q, v), rtol=1e-12, atol=1e-12)
+    assert np.count_nonzero(R.contact_force[..., 2]) > 0, "the spheres touch the plane"
+    without = rd.rollout(model, q0, v0, 0.15, 2e-3, law, every=15)
+    assert without.contact_force is None and without.q.shape == (2, 6, model.nq)
+    far = Contacts(contacts.shapes, surfaces=[Plane(height=-100.0)])  # the same steps, out of reach
+    traj = rd.simulate(model, q0[1], v0, 0.15, 2e-3, law, contacts=far, progress=False)
+    np.testing.assert_allclose(without.q[1], traj.q[::15], rtol=1e-9, atol=1e-9)
+
+
+def test_a_coupled_model_rolls_out_with_its_own_masses():
+    from test_mimic import MODELS
+
+    model = MODELS[1]
+    q0 = rd.random.random_configuration(model, np.random.default_rng(7))
+    theta = np.stack([model.full.theta, 2.0 * model.full.theta])
+    R = rd.rollout(model, q0, np.zeros(model.nv), 0.05, 1e-3, theta=theta)
+    far = Contacts([rd.contact.Sphere(1, 0.05)], surfaces=[Plane(height=-100.0)])  # the steps without contacts
+    for b in range(2):
+        heavy = rd.CoupledModel(model.full.replace(theta=theta[b]), model.mimic)
+        traj = rd.simulate(heavy, q0, np.zeros(model.nv), 0.05, 1e-3, contacts=far, progress=False)
+        np.testing.assert_allclose(R.q[b], traj.q, rtol=1e-9, atol=1e-12)
+    assert not np.allclose(R.q[0], R.q[1])

@@ -102,7 +102,9 @@ def _simulation_steps(rd, model):
                                                                    python_law))] + [
         ("simulate (contacts, mimic couplings)",
          lambda: rd.simulate(coupled, qc, np.zeros(coupled.nv), 0.004, 0.002, contacts=touch, progress=False)),
-        ("rollout (contacts)", lambda: rd.rollout(model, np.stack([q0, q0]), v0, 0.004, 0.002, pd, contacts=touch))]
+        ("rollout (contacts)", lambda: rd.rollout(model, np.stack([q0, q0]), v0, 0.004, 0.002, pd, contacts=touch)),
+        ("rollout (contacts, mimic couplings)",
+         lambda: rd.rollout(coupled, np.stack([qc, qc]), np.zeros(coupled.nv), 0.004, 0.002, contacts=touch))]
 
 
 def _public():
@@ -129,7 +131,8 @@ def _public():
 
 def steps():
     """Every warm-up step as ``(name, call)``, in order: the algorithms on a fixed-base and a
-    floating-base model, one state and a batch of two, then the simulations."""
+    floating-base model, one state and a batch of two, the paths of a model with mimic
+    couplings, then the simulations."""
     from .random import random_model, random_state
 
     rd = _public()
@@ -141,7 +144,26 @@ def steps():
             q, v, a = random_state(model, np.random.default_rng(0), size)
             label = f"{'floating' if floating else 'fixed'} base, {'batch' if size else 'one state'}"
             out += [(f"{name} ({label})", call) for name, call in _algorithm_steps(rd, model, q, v, a)]
+    out += _coupled_steps(rd, random_model(6, seed=0, floating_base=True, branching=0.0))
     out += _simulation_steps(rd, random_model(6, seed=0, floating_base=False, branching=0.0))
+    return out
+
+
+def _coupled_steps(rd, model):
+    """The compiled paths of a model with mimic couplings (``rnea``, ``crba``, ``aba``: one
+    state and a batch of two)."""
+    from .joints import NV
+    from .random import random_state
+
+    one = [name for name, t in zip(model.body_joint_names, model.joint_type) if NV[t] == 1]
+    coupled = rd.CoupledModel(model, [(one[-1], one[0], 1.0, 0.0)])
+    out = []
+    for size in ((), (2,)):
+        q, v, a = random_state(coupled, np.random.default_rng(0), size)
+        label = f"mimic couplings, {'batch' if size else 'one state'}"
+        out += [(f"rnea ({label})", lambda q=q, v=v, a=a: rd.rnea(coupled, q, v, a)),
+                (f"crba ({label})", lambda q=q: rd.crba(coupled, q)),
+                (f"aba ({label})", lambda q=q, v=v, a=a: rd.aba(coupled, q, v, a))]
     return out
 
 

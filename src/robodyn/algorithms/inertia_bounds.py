@@ -142,6 +142,7 @@ from scipy.optimize import minimize
 from scipy.stats import qmc
 
 from .. import joints as J
+from ..coupling import is_coupled, not_supported
 from .coriolis import christoffel_symbols
 from .crba import crba
 
@@ -564,6 +565,9 @@ def inertia_bounds(model, lower=None, upper=None, *, rtol: float = 0.01, max_box
     joints only; the armature is included, as in :func:`robodyn.crba`. Reference: the
     bounded-inertia property, Spong, Hutchinson & Vidyasagar (2006), 7.5.2.
     """
+    if is_coupled(model):
+        raise not_supported(model, "inertia_bounds", "M(q) after q_m = r q_s + o is a trigonometric polynomial of "
+                                                     "a higher degree than the bounds take")
     if np.any(model.joint_type != J.REVOLUTE):
         raise ValueError("inertia_bounds: revolute joints only (a prismatic, free, ball, planar or helical joint "
                          "makes M(q) non-periodic in it; bound an arm without its gripper's fingers)")

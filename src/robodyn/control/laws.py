@@ -17,9 +17,10 @@ import numpy as np
 
 from .._jit import inline, kernel
 from ..algorithms.jacobian import jacobian_one
-from ..algorithms.rnea import motion_workspace, rnea_one
+from ..algorithms.rnea import motion_workspace, rnea_coupled_state, rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import CHECKED, NO_WRENCH, OK
+from ..joint_kernels import nq_of
 
 CONSTANT = 0         # the constant command tau_cmd (zero: the free robot)
 PD_GRAVITY = 1       # Kp (q_d - q) - Kd qd + g(q)
@@ -61,9 +62,10 @@ def reference_at(breaks, coefs, t, qd, vd, ad):
 def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
     """The command of a compiled control law at ``(t, q, v)`` into ``out``; returns a status.
 
-    ``c = (ints, body, dofs_gravity, dofs_full, params, zero_wrench)`` of the controller's model
-    (``dofs_gravity`` without friction and armature, ``dofs_full`` with them);
-    ``gains[0] = Kp``, ``gains[1] = Kd``."""
+    ``c = (ints, body, dofs_gravity, dofs_full, params, zero_wrench, cints, cfloats)`` of the
+    controller's model (``dofs_gravity`` without friction and armature, ``dofs_full`` with
+    them; for a model with mimic couplings its full tree's and its ``CouplingTables``, empty
+    for a tree), the law in the model's coordinates; ``gains[0] = Kp``, ``gains[1] = Kd``."""
     if law == CONSTANT:
         for k in range(out.shape[0]):
             out[k] = tau_cmd[k]
@@ -72,23 +74,42 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
         for k in range(out.shape[0]):
             out[k] = gains[4, k] + gains[0, k] * (gains[3, k] - q[int(gains[2, k])]) - gains[1, k] * v[k]
         return OK
-    ws, qd, vd, ad, acc, zero = cws
+    ws, qd, vd, ad, acc, zero, buf = cws
     reference_at(breaks, coefs, t, qd, vd, ad)
     if law == PD_GRAVITY:
-        st = rnea_one(c[0], c[1], c[2], c[4], q, zero, zero, c[5], NO_WRENCH, CHECKED, out, ws)
+        st = law_rnea(c, c[2], q, zero, zero, ws, buf, out)
         for k in range(out.shape[0]):
             out[k] += gains[0, k] * (qd[k] - q[k]) - gains[1, k] * v[k]
         return st
     for k in range(out.shape[0]):
         acc[k] = ad[k] + gains[1, k] * (vd[k] - v[k]) + gains[0, k] * (qd[k] - q[k])
-    return rnea_one(c[0], c[1], c[3], c[4], q, v, acc, c[5], NO_WRENCH, CHECKED, out, ws)
+    return law_rnea(c, c[3], q, v, acc, ws, buf, out)
+
+
+@inline
+def law_rnea(c, dofs, q, v, a, ws, buf, out):
+    """The RNEA of the controller's model ``c`` (see :func:`law_torque`) with ``dofs``: the
+    tree's, or with mimic couplings ``G^T rnea_full(E(q), G v, G a)`` (``buf``: the full
+    tree's state, see ``rnea.coupled_workspace``)."""
+    if c[6].shape[0] == 0:
+        return rnea_one(c[0], c[1], dofs, c[4], q, v, a, c[5], NO_WRENCH, CHECKED, out, ws)
+    return rnea_coupled_state(c[0], c[1], dofs, c[4], c[6], c[7], q, v, a, c[5], NO_WRENCH, CHECKED, out, (ws, buf))
 
 
 @kernel
-def law_workspace(nb, nv):
+def law_workspace(nb, nv, nqf, nvf):
     """Scratch ``cws`` of :func:`law_torque` for a controller model of ``nb`` bodies and ``nv``
-    dofs: the RNEA's, the reference ``(q_d, v_d, a_d)``, the commanded acceleration, zeros."""
-    return rnea_workspace(nb), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv)
+    dofs (``nqf``, ``nvf``: its tree's sizes, see :func:`law_sizes`): the RNEA's, the
+    reference ``(q_d, v_d, a_d)``, the commanded acceleration, zeros, and the full tree's
+    state of a model with mimic couplings."""
+    return (rnea_workspace(nb), np.empty(nv), np.empty(nv), np.empty(nv), np.empty(nv), np.zeros(nv),
+            np.empty(nqf + 3 * nvf))
+
+
+@inline
+def law_sizes(c):
+    """``(nb, nq, nv)`` of the tree of the controller model ``c`` (see :func:`law_torque`)."""
+    return c[0].shape[0], nq_of(c[0]), c[2].shape[0]
 
 
 @kernel

@@ -1,5 +1,5 @@
-"""Compiled time stepping with contacts: one step (the model of :mod:`robodyn.contact.solver`)
-and whole runs under a compiled control law.
+"""Compiled time stepping with contacts: one step (the model of :mod:`robodyn.contact.solver`);
+whole runs under a compiled control law are in :mod:`._contact_runs`.
 
 A step from ``(q, v)`` under the command ``tau_cmd`` (clipped to the effort limits):
 ``h = rnea(q, v, 0)``, ``M = crba(q) = L L^T``, the free velocity ``v_f``, the contact pairs
@@ -16,14 +16,13 @@ import numpy as np
 from .._jit import core, inline, kernel
 from ..algorithms.crba import crba_one
 from ..algorithms.crba import workspace as crba_workspace
+from ..algorithms.dense import backward, cholesky, forward
 from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
 from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
-from ..contact.solver import (ACTIVE, BODY, BODY_SPHERE, BOUNCE_SPEED, FRICTION, INFO_SIZE, ITERATIONS, KIND, MARGIN,
+from ..contact.solver import (ACTIVE, BODY, BODY_SPHERE, BOUNCE_SPEED, FRICTION, ITERATIONS, KIND, MARGIN,
                               MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL, RESTITUTION, STABILIZATION, TOLERANCE,
-                              backward, cholesky, contact_frame, delassus, forward, point_rows, solve,
-                              surface_distance)
-from ..control.laws import law_torque, law_workspace
+                              contact_frame, delassus, point_rows, solve, surface_distance)
 from ..joints import FREE, PLANAR
 from ..layout import IV, JTYPE
 from ._kernels import chart_point, chart_rate
@@ -271,108 +270,3 @@ def step_kernel(ints, body, dofs, params, fext, fcode, limit, points, centers, r
     """Compiled :func:`step` for the Python-driven controllers."""
     return step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, tau_cmd, dt,
                 tau, a, q1, v1, force, geom, warm, info, ws)
-
-
-@kernel
-def run_workspace(nb, nv, npairs, ncb, nq):
-    """Scratch of :func:`run_steps`: the step's, the control law's (a model of ``ncb`` bodies),
-    the command, the next state and the warm start."""
-    return (workspace(nb, nv, npairs), law_workspace(ncb, nv), np.empty(nv), np.empty(nq), np.empty(nv),
-            np.zeros((npairs, 3)))
-
-
-@inline
-def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
-              radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws):
-    """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
-    ``simulate._run_compiled``), writing ``Q[1:], V[1:]`` and, for every sample but the last
-    unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
-    solver ``info``; ``warm`` (npairs, 3) the impulses of the step before. ``rws``:
-    :func:`run_workspace`. Returns ``(status, sample)`` of the first failure (``(OK, -1)``)."""
-    ws, law_ws, cmd, qn, vn = rws[0], rws[1], rws[2], rws[3], rws[4]
-    n = Q.shape[0] - 1
-    for s in range(n + 1 if final else n):
-        q, v = Q[s], V[s]
-        st = law_torque(law, c, gains, breaks, coefs, (s0 + s) * dt, q, v, tau_cmd, law_ws, cmd)
-        if st == OK:
-            st = step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q, v, cmd,
-                      dt, T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], ws)
-        if st != OK:
-            return st, s
-        if s < n:
-            for k in range(qn.shape[0]):
-                Q[s + 1, k] = qn[k]
-            for k in range(vn.shape[0]):
-                V[s + 1, k] = vn[k]
-    return OK, -1
-
-
-@kernel
-def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii,
-        surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
-    """:func:`run_steps` of one simulation."""
-    rws = run_workspace(ints.shape[0], V.shape[1], D.shape[1], c[0].shape[0], Q.shape[1])
-    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
-                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws)
-
-
-@kernel
-def rollout_workspace(nb, nv, npairs, ncb, nq, every):
-    """Scratch of :func:`rollout_at`: :func:`run_workspace`'s and the ``every + 1`` samples
-    of one segment."""
-    m = every + 1
-    return run_workspace(nb, nv, npairs, ncb, nq) + (
-        np.empty((m, nq)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, npairs, 3)),
-        np.empty((m, npairs, 4)), np.empty((m, INFO_SIZE)))
-
-
-@inline
-def _keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
-    """Sample ``k`` of the outputs from row ``j`` of a segment (its step's results)."""
-    for r in range(A.shape[1]):
-        A[k, r], T[k, r] = As[j, r], Ts[j, r]
-    for p in range(D.shape[1]):
-        for r in range(3):
-            Fc[k, p, r] = Fs[j, p, r]
-        for r in range(4):
-            D[k, p, r] = Ds[j, p, r]
-    for r in range(info.shape[1]):
-        info[k, r] = Is[j, r]
-
-
-@inline
-def rollout_at(args, b, rws):
-    """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
-    ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
-    ``args[-1][b]``. ``bodies`` (B or 1, nb, BODY_COLUMNS): the body table of each rollout
-    (its inertial parameters), or one for all."""
-    (ints, bodies, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, law, gains, breaks, coefs, tau_cmd,
-     points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed) = args
-    c = (c0, c1, c2, c3, c4, c5)  # the law's model, flat in ``args`` (a parallel loop takes no nested tuple)
-    body = bodies[b if bodies.shape[0] > 1 else 0]
-    warm, Qs, Vs, As, Ts, Fs, Ds, Is = rws[5], rws[6], rws[7], rws[8], rws[9], rws[10], rws[11], rws[12]
-    for p in range(warm.shape[0]):
-        for r in range(3):
-            warm[p, r] = 0.0
-    kept = Q.shape[1]
-    for k in range(kept):
-        last = k == kept - 1
-        for r in range(Qs.shape[1]):
-            Qs[0, r] = Q[b, k, r]
-        for r in range(Vs.shape[1]):
-            Vs[0, r] = V[b, k, r]
-        m = 1 if last else every + 1
-        st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
-                          centers, radii, surf, settings, k * every, dt, last, Qs[:m], Vs[:m], As[:m], Ts[:m],
-                          Fs[:m], Ds[:m], Is[:m], warm, rws)
-        if st != OK:
-            failed[b] = k * every + s
-            return st
-        _keep(Qs, Vs, As, Ts, Fs, Ds, Is, 0, A[b], T[b], Fc[b], D[b], info[b], k)
-        if not last:
-            for r in range(Qs.shape[1]):
-                Q[b, k + 1, r] = Qs[every, r]
-            for r in range(Vs.shape[1]):
-                V[b, k + 1, r] = Vs[every, r]
-    failed[b] = -1
-    return OK

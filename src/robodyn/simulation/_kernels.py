@@ -23,7 +23,7 @@ import numpy as np
 from .._jit import inline, kernel
 from ..layout import IQ, IV, JTYPE
 from ..algorithms.status import CHECKED, OK
-from ..control.laws import law_torque, law_workspace
+from ..control.laws import law_sizes, law_torque, law_workspace
 from ..algorithms.aba import aba_one
 from ..algorithms.aba import workspace as aba_workspace
 from ..joints import FREE, PLANAR, SPHERICAL
@@ -139,7 +139,8 @@ def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coe
     Returns ``(status, sample)`` of the first failing evaluation (``(OK, -1)`` on success)."""
     nv = v0.shape[0]
     ws, R = stage_workspace(ints.shape[0], q0.shape[0], nv)
-    cws = law_workspace(c[0].shape[0], nv)
+    nb, nqf, nvf = law_sizes(c)
+    cws = law_workspace(nb, nv, nqf, nvf)
     th = np.zeros(nv)
     thi = np.empty(nv)
     vi = np.empty(nv)

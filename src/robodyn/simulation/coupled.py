@@ -80,13 +80,20 @@ def reduced_trajectory(model, traj, user_constraints: bool):
     return replace(traj, model=model, q=traj.q[:, iq], v=traj.v[:, iv], a=traj.a[:, iv], tau=traj.tau[:, iv],
                    q_desired=None if traj.q_desired is None else traj.q_desired[:, iq],
                    v_desired=None if traj.v_desired is None else traj.v_desired[:, iv],
-                   constraint_force=cf[:, :cf.shape[1] - len(model.mimic)] if user_constraints else None)
+                   constraint_force=cf[:, :cf.shape[1] - len(model.mimic)] if user_constraints else None,
+                   joint_friction=None if traj.joint_friction is None else traj.joint_friction[:, iv])
+
+
+def run_coupling(model) -> tuple:
+    """``(cmap, cscale, independent, independent_q)``: the coupling arguments of the compiled
+    runs (``_contact_runs``): :func:`contact_coupling` and the independent coordinates."""
+    return (*contact_coupling(model), np.ascontiguousarray(model.independent_q, dtype=np.int64))
 
 
 def contact_coupling(model) -> tuple:
     """``(cmap, cscale, independent)`` of :mod:`._coupled_contact_step`: ``G[k, cmap[k]] =
-    cscale[k]``, the only entry of row ``k`` of ``G``, and the full dofs of the independent ones."""
-    G = np.asarray(model.G)
-    cmap = np.abs(G).argmax(axis=1).astype(np.int64)
-    return cmap, np.ascontiguousarray(G[np.arange(G.shape[0]), cmap]), np.ascontiguousarray(model.independent_v,
-                                                                                          dtype=np.int64)
+    cscale[k]``, the only entry of row ``k`` of ``G`` (the model's ``CouplingTables``), and the
+    full dofs of the independent ones."""
+    nvf, tables = model.full.nv, model.tables
+    return (np.ascontiguousarray(tables.ints[2:2 + nvf]), np.ascontiguousarray(tables.floats[:nvf]),
+            np.ascontiguousarray(model.independent_v, dtype=np.int64))

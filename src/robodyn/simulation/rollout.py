@@ -10,7 +10,9 @@ see ``_contact_step.moving_frame_terms``; for other joints it is ``simulate``'s
 semi-implicit Euler), run on all threads in compiled code (as MuJoCo's ``rollout``). Each
 rollout equals the single simulation with contacts from its initial state to the last bit.
 The controller must run in compiled code: None, ``control.PDGravity``, ``ComputedTorque`` or
-``JointPD``.
+``JointPD``. A model with mimic couplings (:class:`~robodyn.CoupledModel`) is stepped as
+:func:`robodyn.simulate` steps it with contacts (its full tree's state on the coupling, the
+coupled model's own step), its controller in the independent coordinates.
 """
 
 from __future__ import annotations
@@ -25,10 +27,13 @@ from ..algorithms.driver import batch_kernel, chunks
 from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
 from ..errors import RobodynWarning
-from . import _contact_step as CK
+from ..coupling import expand_q, expand_v, is_coupled, joint_tree
+from . import _contact_runs as CR
+from .coupled import run_coupling
 from .simulate import law_arrays, compiled_law, positive_number, raise_at, unit_configuration
 
-_batch = batch_kernel(CK.rollout_at, CK.rollout_workspace)
+_batch = batch_kernel(CR.rollout_at, CR.rollout_workspace)
+_coupled_batch = batch_kernel(CR.rollout_at, CR.coupled_rollout_workspace)
 
 
 @dataclass(frozen=True)
@@ -70,7 +75,7 @@ def _bodies(model, theta, B: int) -> np.ndarray:
     from ..layout import INERTIA, INERTIA_END
     from ..model import consistent_inertial_parameters
 
-    body = model.kernel.body
+    body = joint_tree(model).kernel.body
     if theta is None:
         return body[None]
     try:
@@ -119,12 +124,13 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     if (cmodel.nq, cmodel.nv) != (model.nq, model.nv):
         raise ValueError(f"controller: its model has nq={cmodel.nq}, nv={cmodel.nv}; the simulated model has "
                          f"nq={model.nq}, nv={model.nv}")
+    tree = joint_tree(model)
     if contacts is not None:
         from ..contact.geometry import Contacts
 
         if not isinstance(contacts, Contacts):
             raise ValueError(f"contacts: expected a robodyn.contact.Contacts or None, got {type(contacts).__name__}")
-        (points, centers, radii), surf, settings, names = contacts.pack(model)
+        (points, centers, radii), surf, settings, names = contacts.pack(tree)
     else:
         points, centers, radii = np.zeros(0, np.int64), np.zeros((0, 3)), np.zeros(0)
         surf, settings, names = np.zeros((0, CS.SURFACE_COLUMNS)), np.array([1.0, 1.0, 0.0, 0.0, 0.0, 0.0]), ()
@@ -132,29 +138,41 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or every < 1 or n % every:
         raise ValueError(f"every: expected an integer >= 1 dividing the {n} steps, got {every!r}")
     N, npairs = n // every + 1, len(names)
-    Q, V = np.empty((B, N, model.nq)), np.empty((B, N, model.nv))
+    Q, V = np.empty((B, N, tree.nq)), np.empty((B, N, tree.nv))
+    if is_coupled(model):  # the full tree's state on the coupling
+        q0, v0 = expand_q(model, q0), expand_v(model, v0)
     Q[:, 0] = q0
     V[:, 0] = v0
-    unit_configuration(model, Q[:, 0])
-    A, T = np.zeros((B, N, model.nv)), np.zeros((B, N, model.nv))
+    unit_configuration(tree, Q[:, 0])
+    A, T = np.zeros((B, N, tree.nv)), np.zeros((B, N, tree.nv))
     Fc, D, info = np.zeros((B, N, npairs, 3)), np.zeros((B, N, npairs, 4)), np.zeros((B, N, CS.INFO_SIZE))
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
-    k = model.kernel
+    k = tree.kernel
     c, law, gains, breaks, coefs = law_arrays(model, compiled)
+    law_tree = joint_tree(cmodel)
+    law_sizes = (law_tree.nbodies, law_tree.nq, law_tree.nv)
+    coupling = run_coupling(model) if is_coupled(model) else (None,) * 4
     args = (k.ints, bodies, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
-            np.ascontiguousarray(model.effort_limit),
+            np.ascontiguousarray(tree.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
-            Q, V, A, T, Fc, D, info, failed)
-    _batch(args, (model.nbodies, model.nv, npairs, c[0].shape[0], model.nq, int(every)), status, chunks(B))
+            Q, V, A, T, Fc, D, info, failed, *coupling)
+    if is_coupled(model):
+        _coupled_batch(args, (model.nbodies, tree.nv, model.nv, npairs, *law_sizes, tree.nq, model.nq, int(every)),
+                       status, chunks(B))
+    else:
+        _batch(args, (model.nbodies, model.nv, npairs, *law_sizes, model.nq, int(every)), status, chunks(B))
     bad = np.flatnonzero(status != OK)
     if bad.size:
         b = int(bad[0])
         s, k = int(failed[b]), int(failed[b]) // every
         try:
-            raise_at(model, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
+            raise_at(tree, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
         except ValueError as e:
             raise ValueError(f"rollout {b}: {e}") from None
     t = np.arange(0, n + 1, every) * dt
+    if is_coupled(model):  # read in the independent coordinates
+        iq, iv = model.independent_q, model.independent_v
+        Q, V, A, T = Q[..., iq], V[..., iv], A[..., iv], T[..., iv]
     if contacts is None:
         return Rollouts(model, t, Q, V, A, T)
     residual = info[..., CS.RESIDUAL]

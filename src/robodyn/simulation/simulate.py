@@ -21,12 +21,13 @@ import numpy as np
 
 from .._deprecated import renamed_keyword
 from .. import joints as J
-from ..coupling import is_coupled
+from ..coupling import is_coupled, joint_tree
 from ..algorithms.rnea import external_wrenches, rnea
 from ..algorithms.status import OK, raise_for_status
 from ..contact import solver as CS
 from ..control.laws import CONSTANT
 from ..errors import RobodynWarning, user_stacklevel
+from . import _contact_runs as CR
 from . import _contact_step as CK
 from . import _coupled_contact_step as CCK
 from . import _kernels as K
@@ -265,7 +266,8 @@ def simulate(model, q0, v0, duration: float, dt: float, controller=None, integra
             the torque on it stays below its breakaway level ``coulomb + stribeck``, where the
             smooth law (``coulomb_smoothing``) creeps and the sign law chatters; the friction
             torques are sampled into ``traj.joint_friction``. Not with contacts or
-            constraints; from Python.
+            constraints; from Python. A model with mimic couplings solves it in its
+            independent coordinates (see ``stiction.run_stiction``).
 
     Returns:
         :class:`Trajectory` (t, q, v, a, tau, energies, Lyapunov function, reference).
@@ -324,7 +326,8 @@ def _simulate_tree(model, q0, v0, duration, dt, controller, integrator, *, conta
                    baumgarte, rtol, atol, progress, stiction, coupling=None) -> Trajectory:
     """:func:`simulate` of a tree, its arguments checked; with ``coupling`` (a
     :class:`~robodyn.coupling.CoupledModel` whose ``full`` is ``model``), the contact steps of
-    the coupled model on the full tree's state (:mod:`._coupled_contact_step`)."""
+    the coupled model on the full tree's state (:mod:`._coupled_contact_step`), or its
+    stiction (the tree under the couplings, the friction in the independent coordinates)."""
     unit_configuration(model, q0)
     n = max(1, int(round(duration / dt)))
     t = np.arange(n + 1) * dt
@@ -349,11 +352,12 @@ def _simulate_tree(model, q0, v0, duration, dt, controller, integrator, *, conta
     Z = np.empty((n + 1, law.nz))
     Z[0] = law.z0
     compiled = None
-    if integrator in INTEGRATORS and not law.stateful and plant.compiled and coupling is None:
-        compiled = (CONSTANT, None, None, None, None) if controller is None else compiled_law(controller)
+    if integrator in INTEGRATORS and not law.stateful and plant.compiled:
+        inner = controller.controller if isinstance(controller, coupled.ReducedLaw) else controller
+        compiled = (CONSTANT, None, None, None, None) if inner is None else compiled_law(inner)
     touch = friction = None
     if stiction:
-        friction = run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar)[0]
+        friction = run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, coupling=coupling)[0]
     elif contacts is not None:
         touch = _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, bar, coupling)
     elif compiled is not None:
@@ -380,10 +384,11 @@ def _simulate_coupled(model, q0, v0, duration, dt, controller, integrator, *, co
     """:func:`simulate` of a model with mimic couplings: its full tree under the couplings
     (:mod:`robodyn.simulation.coupled`), with contacts by the coupled model's own contact step
     (:mod:`._coupled_contact_step`), read back in the independent coordinates."""
-    if stiction:
-        raise ValueError("simulate: stiction with mimic couplings (a CoupledModel) is not supported: the couplings "
-                         "are held as bilateral constraints, which the set-valued friction does not combine with; "
-                         "load the robot with mimic='independent'")
+    if stiction:  # the friction solved in the independent coordinates (stiction.run_stiction)
+        q0f, v0f, law, held = coupled.full_tree_problem(model, q0, v0, controller, ())
+        traj = _simulate_tree(model.full, q0f, v0f, duration, dt, law, "semi_implicit_euler", contacts=None,
+                              constraints=held, stiction=True, coupling=model, **options)
+        return coupled.reduced_trajectory(model, traj, False)
     user = () if constraints is None else (constraints if isinstance(constraints, (list, tuple)) else (constraints,))
     if contacts is not None:  # the tree's checks refuse the caller's constraints with contacts
         q0f, v0f, law, _ = coupled.full_tree_problem(model, q0, v0, controller, ())
@@ -417,14 +422,19 @@ def compiled_law(controller):
 
 
 def law_arrays(model, compiled):
-    """``(c, law, gains, breaks, coefs)``: the arguments of ``laws.law_torque`` for a compiled law."""
+    """``(c, law, gains, breaks, coefs)``: the arguments of ``laws.law_torque`` for a compiled law
+    (its model's tree and, for a model with mimic couplings, its ``CouplingTables``)."""
     law, cmodel, gains, breaks, coefs = compiled
     if law == CONSTANT:
         nv = model.nv
         cmodel, gains, breaks, coefs = model, np.zeros((2, nv)), np.array([0.0, 1.0]), np.zeros((1, 1, nv))
-    k = cmodel.kernel
-    return (k.ints, k.body, k.dofs[False, False], k.dofs[True, True], k.params[True], k.zero_wrench), law, gains, \
-        breaks, coefs
+    tables = cmodel.tables if is_coupled(cmodel) else NO_COUPLING
+    k = joint_tree(cmodel).kernel
+    return (k.ints, k.body, k.dofs[False, False], k.dofs[True, True], k.params[True], k.zero_wrench, *tables), law, \
+        gains, breaks, coefs
+
+
+NO_COUPLING = (np.zeros(0, np.int64), np.zeros(0))  # a law's model without mimic couplings (see law_torque)
 
 
 def _run_compiled(plant, compiled, integrator, q0, v0, dt, t, Q, V, A, T, bar):
@@ -462,7 +472,8 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
     """Time stepping with contacts (see ``_contact_step``): compiled runs under a compiled
     law (in pieces of about 1% of the run when the progress bar is shown), else one compiled
     step per sample from a Python loop (with ``coupling``, the coupled model's step,
-    ``_coupled_contact_step``, on the full tree's state); warns when a solve did not converge."""
+    ``_coupled_contact_step``, on the full tree's state, and a compiled law in its independent
+    coordinates); warns when a solve did not converge."""
     model = plant.model
     (points, centers, radii), surf, settings, names = contacts.pack(model)
     N, nv, nz = Q.shape[0], model.nv, Z.shape[1]
@@ -477,11 +488,14 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
         c, code, gains, breaks, coefs = law_arrays(model, compiled)
         zero = np.zeros(nv)
         piece = max(1, n // 100) if bar.enabled else n
+        run, extra = CR.run, ()
+        if coupling is not None:  # the law in the independent coordinates
+            run, extra = CR.coupled_run, coupled.run_coupling(coupling)
         for a in range(0, n, piece):
             b = min(n, a + piece)
-            status, s = CK.run(*plant.args, c, code, gains, breaks, coefs, zero, *geometry, a, dt, b == n, Q[a:b + 1],
-                               V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
-                               touch.info[a:b + 1], warm)
+            status, s = run(*plant.args, c, code, gains, breaks, coefs, zero, *geometry, a, dt, b == n, Q[a:b + 1],
+                            V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
+                            touch.info[a:b + 1], warm, *extra)
             if status != OK:
                 raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
             bar.update(b)

@@ -97,16 +97,26 @@ def friction_bound(model, v) -> np.ndarray:
     return model.coulomb + model.stribeck * np.exp(-x * x)
 
 
-def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_above: float = 1e-9):
+def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_above: float = 1e-9, coupling=None):
     """Semi-implicit Euler with exact stiction (module docstring). ``plant`` steps the model
     without its dry friction (``coulomb`` and ``stribeck`` zero); ``model`` holds them.
     Returns ``(friction, residual)``: the friction torques (N, nv) over each step and the
     solves' complementarity residuals (N,). Warns when a solve stopped above ``warn_above``
-    (rad/s)."""
+    (rad/s).
+
+    With ``coupling`` (a :class:`~robodyn.coupling.CoupledModel` whose ``full`` is ``model``,
+    stepped by ``plant`` under its couplings) the friction is solved in the independent
+    coordinates: a dof ``k`` of the tree moves as ``G[k, i] v_i`` with one independent
+    coordinate ``i``, so the dry friction the tree's dofs put on ``i`` is any torque of
+    magnitude up to ``sum_k |G[k, i]| F_k(v_k)`` (the box of each independent coordinate),
+    with the coupled model's ``M^-1``; ``friction`` holds it in the columns of the independent
+    dofs."""
     nv, nz = V.shape[1], Z.shape[1]
     n = Q.shape[0] - 1
     zero, thetadot, vdot = np.zeros(nv), np.empty(nv), np.empty(nv)
-    dry = np.flatnonzero((model.coulomb > 0) | (model.stribeck > 0))
+    G = np.eye(nv) if coupling is None else coupling.G  # v = G v_r
+    dry = np.flatnonzero(np.abs(G).T @ ((model.coulomb > 0) | (model.stribeck > 0)))
+    columns = dry if coupling is None else coupling.independent_v[dry]
     friction, residual = np.zeros((n + 1, nv)), np.zeros(n + 1)
     zdot = np.empty(nz)
     Q[0], V[0] = q0, v0
@@ -118,15 +128,20 @@ def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_abov
         v_free = v + dt * vdot
         v_next = v_free.copy()
         if dry.size:
-            Minv = inverse_mass_matrix(model, q)
-            G = dt * Minv[np.ix_(dry, dry)]
-            bound = friction_bound(model, v)[dry]
-            sol = box_friction(G, v_free[dry], bound, f_dry)
+            if coupling is None:
+                Minv, v_free_r = inverse_mass_matrix(model, q), v_free
+            else:
+                Minv = inverse_mass_matrix(coupling, q[coupling.independent_q])
+                v_free_r = v_free[coupling.independent_v]
+            W = dt * Minv[np.ix_(dry, dry)]
+            bound = (np.abs(G).T @ friction_bound(model, v))[dry]
+            sol = box_friction(W, v_free_r[dry], bound, f_dry)
             f_dry, residual[s] = sol.f, sol.residual
-            friction[s, dry] = f_dry
-            v_next -= dt * (Minv[:, dry] @ f_dry)
+            friction[s, columns] = f_dry
+            v_next_r = v_free_r - dt * (Minv[:, dry] @ f_dry)
             stuck = np.abs(f_dry) < bound
-            v_next[dry[stuck]] = 0.0  # at rest exactly (the solve leaves rounding there)
+            v_next_r[dry[stuck]] = 0.0  # at rest exactly (the solve leaves rounding there)
+            v_next = G @ v_next_r
         A[s] = (v_next - v) / dt
         if s == n:
             break

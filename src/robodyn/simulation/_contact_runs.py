@@ -1,0 +1,187 @@
+"""Compiled runs of the contact time stepping under a compiled control law: one simulation
+(:func:`run`, ``simulate``) and the parallel rollouts (:func:`rollout_at`, ``rollout``).
+
+A run steps ``(q, v)`` with :func:`._contact_step.step`, the command from the law
+(``control.laws.law_torque``) at each step. A model with mimic couplings
+(:class:`~robodyn.coupling.CoupledModel`) is run on its full tree's state with
+:func:`._coupled_contact_step.step`: its law sees the independent coordinates
+``(q[independent_q], v[independent])`` and commands their forces, zero on the mimic dofs. The
+coupling arguments ``cmap, cscale, independent, independent_q`` are None for a tree: Numba
+then prunes the coupled branch at compile time (a test of an argument that is None); the
+coupled kernels type both branches (the tree's step gets an empty workspace, never run).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._jit import inline, kernel
+from ..algorithms.status import OK
+from ..contact.solver import INFO_SIZE
+from ..control.laws import law_sizes, law_torque, law_workspace
+from . import _contact_step as CK
+from . import _coupled_contact_step as CCK
+
+
+@kernel
+def run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq):
+    """Scratch of :func:`run_steps` for a tree: the step's, the control law's (a model of
+    ``law_nb`` bodies, its tree of sizes ``law_nq``, ``law_nv``), the command, the next state,
+    the warm start, and (unused) the coupled runs' reduced state and step workspace."""
+    none = np.empty(0)
+    return (CK.workspace(nb, nv, npairs), law_workspace(law_nb, nv, law_nq, law_nv), np.empty(nv), np.empty(nq),
+            np.empty(nv), np.zeros((npairs, 3)), (none, none, none), none)
+
+
+@kernel
+def coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr):
+    """Scratch of :func:`run_steps` for a coupled model of ``nr`` (``nqr``) independent dofs
+    (coordinates) on a tree of ``nv`` (``nq``): as :func:`run_workspace`, with the coupled
+    step's workspace and the independent state and command."""
+    return (CK.workspace(0, 0, 0), law_workspace(law_nb, nr, law_nq, law_nv), np.empty(nv), np.empty(nq),
+            np.empty(nv), np.zeros((npairs, 3)), (np.empty(nqr), np.empty(nr), np.empty(nr)),
+            CCK.workspace(nb, nv, nr, npairs))
+
+
+@inline
+def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
+              radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, cmap, cscale, independent,
+              independent_q):
+    """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
+    ``simulate._run_compiled``), writing ``Q[1:], V[1:]`` and, for every sample but the last
+    unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
+    solver ``info``; ``warm`` (npairs, 3) the impulses of the step before. ``rws``:
+    :func:`run_workspace` (or :func:`coupled_run_workspace` with the coupling, see the module
+    docstring). Returns ``(status, sample)`` of the first failure (``(OK, -1)``)."""
+    ws, law_ws, cmd, qn, vn = rws[0], rws[1], rws[2], rws[3], rws[4]
+    qr, vr, cmdr = rws[6]
+    cws = rws[7]
+    n = Q.shape[0] - 1
+    for s in range(n + 1 if final else n):
+        q, v, t = Q[s], V[s], (s0 + s) * dt
+        if cmap is None:
+            st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, law_ws, cmd)
+            if st == OK:
+                st = CK.step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q,
+                             v, cmd, dt, T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], ws)
+        else:
+            for i in range(qr.shape[0]):
+                qr[i] = q[independent_q[i]]
+            for i in range(vr.shape[0]):
+                vr[i] = v[independent[i]]
+            st = law_torque(law, c, gains, breaks, coefs, t, qr, vr, tau_cmd, law_ws, cmdr)
+            for k in range(cmd.shape[0]):
+                cmd[k] = 0.0
+            for i in range(cmdr.shape[0]):
+                cmd[independent[i]] = cmdr[i]
+            if st == OK:
+                st = CCK.step(ints, body, dofs, params, fext, fcode, limit, cmap, cscale, independent, points, centers,
+                              radii, surf, settings, q, v, cmd, dt, T[s], A[s], qn, vn, Fc[s], D[s], warm, info[s], cws)
+        if st != OK:
+            return st, s
+        if s < n:
+            for k in range(qn.shape[0]):
+                Q[s + 1, k] = qn[k]
+            for k in range(vn.shape[0]):
+                V[s + 1, k] = vn[k]
+    return OK, -1
+
+
+@kernel
+def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii,
+        surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
+    """:func:`run_steps` of one simulation of a tree."""
+    law_nb, law_nq, law_nv = law_sizes(c)
+    rws = run_workspace(ints.shape[0], V.shape[1], D.shape[1], law_nb, law_nq, law_nv, Q.shape[1])
+    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, None, None,
+                     None, None)
+
+
+@kernel
+def coupled_run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
+                radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, cmap, cscale, independent,
+                independent_q):
+    """:func:`run_steps` of one simulation of a coupled model (see the module docstring)."""
+    law_nb, law_nq, law_nv = law_sizes(c)
+    rws = coupled_run_workspace(ints.shape[0], V.shape[1], independent.shape[0], D.shape[1], law_nb, law_nq, law_nv,
+                                Q.shape[1], independent_q.shape[0])
+    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, cmap, cscale,
+                     independent, independent_q)
+
+
+@kernel
+def segments(nv, nq, npairs, every):
+    """The ``every + 1`` samples of one segment of a rollout (see :func:`rollout_at`)."""
+    m = every + 1
+    return (np.empty((m, nq)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, nv)), np.empty((m, npairs, 3)),
+            np.empty((m, npairs, 4)), np.empty((m, INFO_SIZE)))
+
+
+@kernel
+def rollout_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq, every):
+    """Scratch of :func:`rollout_at` for a tree: :func:`run_workspace`'s and a segment's samples."""
+    return run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq) + (segments(nv, nq, npairs, every),)
+
+
+@kernel
+def coupled_rollout_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr, every):
+    """Scratch of :func:`rollout_at` for a coupled model (see :func:`coupled_run_workspace`)."""
+    return coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr) + (
+        segments(nv, nq, npairs, every),)
+
+
+@inline
+def keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
+    """Sample ``k`` of the outputs from row ``j`` of a segment (its step's results)."""
+    for r in range(A.shape[1]):
+        A[k, r], T[k, r] = As[j, r], Ts[j, r]
+    for p in range(D.shape[1]):
+        for r in range(3):
+            Fc[k, p, r] = Fs[j, p, r]
+        for r in range(4):
+            D[k, p, r] = Ds[j, p, r]
+    for r in range(info.shape[1]):
+        info[k, r] = Is[j, r]
+
+
+@inline
+def rollout_at(args, b, rws):
+    """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
+    ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
+    ``failed[b]``. ``bodies`` (B or 1, nb, BODY_COLUMNS): the body table of each rollout
+    (its inertial parameters), or one for all; the last four arguments the coupling (None for
+    a tree, see the module docstring)."""
+    (ints, bodies, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, c6, c7, law, gains, breaks, coefs,
+     tau_cmd, points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed, cmap, cscale,
+     independent, independent_q) = args
+    c = (c0, c1, c2, c3, c4, c5, c6, c7)  # the law's model, flat in ``args`` (a parallel loop takes no nested tuple)
+    body = bodies[b if bodies.shape[0] > 1 else 0]
+    warm = rws[5]
+    Qs, Vs, As, Ts, Fs, Ds, Is = rws[8]
+    for p in range(warm.shape[0]):
+        for r in range(3):
+            warm[p, r] = 0.0
+    kept = Q.shape[1]
+    for k in range(kept):
+        last = k == kept - 1
+        for r in range(Qs.shape[1]):
+            Qs[0, r] = Q[b, k, r]
+        for r in range(Vs.shape[1]):
+            Vs[0, r] = V[b, k, r]
+        m = 1 if last else every + 1
+        st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+                          centers, radii, surf, settings, k * every, dt, last, Qs[:m], Vs[:m], As[:m], Ts[:m],
+                          Fs[:m], Ds[:m], Is[:m], warm, rws, cmap, cscale, independent, independent_q)
+        if st != OK:
+            failed[b] = k * every + s
+            return st
+        keep(Qs, Vs, As, Ts, Fs, Ds, Is, 0, A[b], T[b], Fc[b], D[b], info[b], k)
+        if not last:
+            for r in range(Qs.shape[1]):
+                Q[b, k + 1, r] = Qs[every, r]
+            for r in range(Vs.shape[1]):
+                V[b, k + 1, r] = Vs[every, r]
+    failed[b] = -1
+    return OK
