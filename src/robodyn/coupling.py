@@ -119,8 +119,7 @@ class CoupledModel:
         if key in _BODY_FIELDS:
             return getattr(self.full, key)
         if key in _TREE_FIELDS:  # indexed by the full tree's coordinates: code that reads them does not map
-            raise not_supported(self, "this function", f"CoupledModel: {key!r} is the full tree's, not of the "
-                                                       "independent coordinates")
+            raise CouplingError(self.full.name, "this function", (key,))
         raise AttributeError(f"'CoupledModel' object has no attribute {key!r}")
 
     @property
@@ -192,14 +191,21 @@ class CouplingTables(NamedTuple):
 
 class CouplingError(ModelError, AttributeError):
     """A function that does not take mimic couplings was given a :class:`CoupledModel` (an
-    ``AttributeError`` too, so that ``hasattr`` and ``getattr`` with a default see no field)."""
+    ``AttributeError`` too, so that ``hasattr`` and ``getattr`` with a default see no field).
+    ``CouplingError(model name, what, why)``; the message is formatted when it is read: the
+    algorithms' fast paths try ``model.kernel`` and take the coupled path on this error."""
+
+    def __str__(self) -> str:
+        name, what, why = self.args
+        if not isinstance(why, str):  # a field of the full tree's coordinates (CoupledModel.__getattr__)
+            why = f"CoupledModel: {why[0]!r} is the full tree's, not of the independent coordinates"
+        return (f"{name}: {what} does not take a model with mimic couplings ({why}) yet; pass model.full (the "
+                f"mimic joints as independent joints) or load the file with mimic='independent'")
 
 
-def not_supported(model: CoupledModel, what: str, why: str) -> "CouplingError":
+def not_supported(model: CoupledModel, what: str, why: str) -> CouplingError:
     """The error of a function (``what``) that does not take a model with mimic couplings yet."""
-    return CouplingError(f"{model.full.name}: {what} does not take a model with mimic couplings ({why}) yet; pass "
-                         f"model.full (the mimic joints as independent joints) or load the file with "
-                         f"mimic='independent'")
+    return CouplingError(model.full.name, what, why)
 
 
 def follow_chains(name: str, joint_names, mimic) -> dict:

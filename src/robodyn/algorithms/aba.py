@@ -573,18 +573,18 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba()")
-    if is_coupled(model) and not any_lazy(q, v, tau, f_ext):  # mimic joints: M a = tau - h, independent coordinates
-        return coupled.run_aba(model, q, v, tau, f_ext, frame, friction, armature, check_finite, out)
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
-            k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
+            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
             if _aba_packed(k.ints, k.packed[friction, armature], q, v, tau, check_finite, qdd) == OK:
                 return qdd
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
     if any_lazy(q, v, tau, f_ext):
         return deferred(aba, locals())
+    if is_coupled(model):  # mimic joints: the compiled coupled path (after the fast path: free for a tree)
+        return coupled.run_aba(model, q, v, tau, f_ext, frame, friction, armature, check_finite, out)
     k = model.kernel
     batch, x = _inputs.states(model, q=q, v=v, tau=tau)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)

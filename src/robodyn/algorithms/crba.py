@@ -217,17 +217,17 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     Equivalence: column ``j`` equals ``rnea(q, 0, e_j) - gravity(q)``; ``v^T M v / 2`` is the
     kinetic energy. Reference: RBDA Table 6.2 (composite-rigid-body algorithm).
     """
-    if is_coupled(model) and not any_lazy(q):  # G^T M_full G
-        return run_coupled(model, q, armature, check_finite, out)
     M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
-        k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
+        k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
         if _crba_packed(k.ints, k.packed[False, armature], q, check_finite, M) == OK:
             return M
     except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or armature not bool)
         pass
     if any_lazy(q):
         return deferred(crba, locals())
+    if is_coupled(model):  # mimic joints: the compiled coupled path (after the fast path: free for a tree)
+        return run_coupled(model, q, armature, check_finite, out)
     batch, x = _inputs.states(model, q=q)
     dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)

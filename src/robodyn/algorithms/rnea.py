@@ -324,18 +324,18 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea()")
-    if is_coupled(model) and not any_lazy(q, v, a, f_ext):  # tau = G^T tau_full(E(q), G v, G a)
-        return run_coupled(model, q, v, a, f_ext, frame, friction, armature, check_finite, out)
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         tau = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks sizes and values
         try:
-            k = model.kernel  # a CoupledModel (mimic joints) has none: it was lazy (deferred below)
+            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
             if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
     if any_lazy(q, v, a, f_ext):
         return deferred(rnea, locals())
+    if is_coupled(model):  # mimic joints: the compiled coupled path (after the fast path: free for a tree)
+        return run_coupled(model, q, v, a, f_ext, frame, friction, armature, check_finite, out)
     batch, x = _inputs.states(model, q=q, v=v, a=a)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     return run(model, batch, x, F, fcode, check_finite, friction=friction, armature=armature, out=out)
