@@ -8,12 +8,17 @@ lists, strided and read-only arrays), and their errors.
 
 from __future__ import annotations
 
+import threading
+import time
+from concurrent.futures import ThreadPoolExecutor
+
 import dask.array as da
 import numpy as np
 import pytest
 
 import robodyn as rd
 from helpers import assert_rel, rng_for, states
+from robodyn import _jit
 from robodyn.algorithms import coupled, crba, rnea
 from test_mimic import IDS, MODELS, full_state
 
@@ -93,7 +98,48 @@ def test_every_input_form_gives_the_same_result():
     for fn in (rnea._rnea_coupled_one, crba._crba_coupled_one, coupled._aba_coupled_one):
         assert len(fn.dispatcher.signatures) == 1, "a second specialisation was compiled"
         with pytest.raises(TypeError):
-            fn.dispatcher(*([q.tolist()] * 7))
+            fn.dispatcher(*([q.tolist()] * len(fn.signature.args)))
+
+
+def test_the_first_concurrent_calls_compile_once():
+    """Threads making the first call together: one compiles, the others wait and then run the
+    compiled kernel (none calls the compiler after it was closed to other signatures)."""
+    model = MODELS[3]
+    q = states(model, "threads")[0]
+    compiled = []
+
+    class SlowDispatcher:  # the real dispatcher, its compile slowed to widen the race
+        def __init__(self, real):
+            self.real = real
+
+        def compile(self, signature):
+            compiled.append(signature)
+            time.sleep(0.05)
+            self.real.compile(signature)
+
+        def disable_compile(self):
+            self.real.disable_compile()
+
+        def __call__(self, *args):
+            return self.real(*args)
+
+    one = crba._crba_coupled_one
+    fresh = _jit._FirstCall(one.__wrapped__, one.signature)
+    fresh.dispatcher = SlowDispatcher(fresh.dispatcher)
+    k, tables = model.full.kernel, model.tables
+    outs = [np.empty((model.nv, model.nv)) for _ in range(4)]
+    start = threading.Barrier(4)
+
+    def first_call(out):
+        start.wait()
+        return fresh(k.ints, k.packed[False, False], tables.ints, tables.floats, q, False, out)
+
+    with ThreadPoolExecutor(4) as pool:
+        statuses = list(pool.map(first_call, outs))
+    assert compiled == [one.signature], "compiled more than once"
+    assert statuses == [0] * 4
+    for out in outs:
+        assert_rel(out, rd.crba(model, q, armature=False), 0.0, "a concurrent first call")
 
 
 def test_out():

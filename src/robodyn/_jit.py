@@ -33,6 +33,8 @@ zero give inf/nan instead of raising (the kernels check their inputs and pivots 
 finiteness checks stay exact.
 """
 
+import threading
+
 from numba import njit
 from numba import types as _types
 
@@ -68,18 +70,25 @@ def fast(*argtypes):
 class _FirstCall:
     """A :func:`fast` kernel compiled at its first call (see :func:`fast_lazy`)."""
 
-    __slots__ = ("dispatcher", "signature", "ready", "__wrapped__")
+    __slots__ = ("dispatcher", "signature", "ready", "_lock", "__wrapped__")
 
     def __init__(self, func, signature):
         self.dispatcher, self.signature, self.ready = njit(**_CALLED)(func), signature, False
+        self._lock = threading.Lock()
         self.__wrapped__ = func
 
     def __call__(self, *args):
         if not self.ready:
-            self.dispatcher.compile(self.signature)
-            self.dispatcher.disable_compile()  # other argument types raise TypeError, as fast()'s
-            self.ready = True
+            self.compile()
         return self.dispatcher(*args)
+
+    def compile(self):
+        """Compile the one signature (once, whichever thread calls first)."""
+        with self._lock:  # a second thread waits here, then finds it ready
+            if not self.ready:
+                self.dispatcher.compile(self.signature)
+                self.dispatcher.disable_compile()  # other types raise TypeError, as fast()'s
+                self.ready = True
 
 
 def fast_lazy(*argtypes):
