@@ -128,30 +128,39 @@ def test_bad_input_is_refused_and_a_failing_rollout_named():
 
 
 # -- models with mimic couplings -------------------------------------------------------------
-def _coupled_runs():
+def _coupled_law(kind, model, q0):
+    """A built-in controller of ``model`` (None, JointPD, PDGravity or ComputedTorque)."""
+    from robodyn.control import ComputedTorque, PointToPoint
+
+    return {None: lambda: None, "JointPD": lambda: JointPD(model, q0[0], 5.0, 1.0),
+            "PDGravity": lambda: PDGravity(model, q0[0], kp=10.0, kd=2.0),
+            "ComputedTorque": lambda: ComputedTorque(model, PointToPoint(q0[0], q0[1], 0.1), kp=20.0, kd=5.0)}[kind]()
+
+
+def _coupled_runs(laws_only: bool = False):
     from test_mimic import MODELS
 
     from robodyn.contact import Sphere
-    from robodyn.control import ComputedTorque, PointToPoint
 
     for index in (0, 1, 3):  # fixed base; floating base; floating with a spherical joint
         model = MODELS[index]
         rng = np.random.default_rng(index)
         q0 = np.stack([rd.random.random_configuration(model, rng) for _ in range(2)])
         contacts = Contacts([Sphere(i, 0.05) for i in range(1, model.nbodies)], surfaces=[Plane(height=-0.4)])
-        laws = [None] if index == 3 else [None, JointPD(model, q0[0], 5.0, 1.0)]
+        kinds = [None] if index == 3 else [None, "JointPD"]
         if index == 0:
-            laws += [PDGravity(model, q0[0], kp=10.0, kd=2.0),
-                     ComputedTorque(model, PointToPoint(q0[0], q0[1], 0.1), kp=20.0, kd=5.0)]
-        for law in laws:
-            yield pytest.param(model, q0, contacts, law, id=f"{model.name}-{type(law).__name__}")
+            kinds += ["PDGravity", "ComputedTorque"]
+        for kind in kinds:
+            if kind is not None or not laws_only:
+                yield pytest.param(model, q0, contacts, kind, id=f"{model.name}-{kind}")
 
 
-@pytest.mark.parametrize("model,q0,contacts,law", list(_coupled_runs()))
-def test_rollouts_of_a_coupled_model_are_its_simulations(model, q0, contacts, law):
+@pytest.mark.parametrize("model,q0,contacts,kind", list(_coupled_runs()))
+def test_rollouts_of_a_coupled_model_are_its_simulations(model, q0, contacts, kind):
     """A :class:`rd.CoupledModel` rolls out as ``simulate`` steps it with contacts (its full
     tree on the coupling, the compiled controller in the independent coordinates, equal to its
     Python call)."""
+    law = _coupled_law(kind, model, q0)
     v0 = np.random.default_rng(5).standard_normal(model.nv)
     R = rd.rollout(model, q0, v0, 0.15, 2e-3, law, contacts=contacts)
     assert R.q.shape == (2, 76, model.nq) and R.tau.shape == (2, 76, model.nv)
@@ -170,6 +179,30 @@ def test_rollouts_of_a_coupled_model_are_its_simulations(model, q0, contacts, la
     far = Contacts(contacts.shapes, surfaces=[Plane(height=-100.0)])  # the same steps, out of reach
     traj = rd.simulate(model, q0[1], v0, 0.15, 2e-3, law, contacts=far, progress=False)
     np.testing.assert_allclose(without.q[1], traj.q[::15], rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("model,q0,contacts,kind", list(_coupled_runs(laws_only=True)))
+def test_a_coupled_rollout_is_the_python_driven_step(model, q0, contacts, kind):
+    """The compiled coupled run (law and step in one kernel) against the step driven from
+    Python (``CCK.step_kernel``, the controller called from Python): the same trajectory, with
+    finite effort limits that clip the command and differ between each source joint and its
+    mimic (the command is clipped to the independent joint's own limit)."""
+    full = model.full
+    v0 = np.random.default_rng(6).standard_normal(model.nv)
+    free = rd.rollout(model, q0, v0, 0.15, 2e-3, _coupled_law(kind, model, q0), contacts=contacts)
+    limit = np.full(full.nv, 1e-3)  # a mimic dof's limit: never its source's
+    limit[model.independent_v] = np.maximum(np.percentile(np.abs(free.tau), 70, axis=(0, 1)), 1e-2)
+    limited = rd.CoupledModel(full.replace(effort_limit=limit), model.mimic)
+    law = _coupled_law(kind, limited, q0)
+    R = rd.rollout(limited, q0, v0, 0.15, 2e-3, law, contacts=contacts)
+    for b in range(2):
+        traj = rd.simulate(limited, q0[b], v0, 0.15, 2e-3, lambda t, q, v: law(t, q, v), contacts=contacts,
+                           progress=False)
+        for key in ("q", "v", "tau", "contact_force"):
+            np.testing.assert_allclose(getattr(R, key)[b], getattr(traj, key), rtol=1e-9, atol=1e-9, err_msg=key)
+    assert np.all(np.abs(R.tau) <= limited.effort_limit + 1e-15)
+    clipped = np.isclose(np.abs(R.tau), limited.effort_limit, rtol=0.0, atol=1e-12)
+    assert clipped.any() and not clipped.all(), "the limits clip some of the commands"
 
 
 def test_a_coupled_model_rolls_out_with_its_own_masses():
