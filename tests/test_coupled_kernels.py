@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 import robodyn as rd
+from robodyn import joints as J
 from helpers import assert_rel, rng_for, states
 from robodyn import _jit
 from robodyn.algorithms import coupled, crba, rnea
@@ -180,6 +181,26 @@ def test_errors_name_the_input():
             call()
     with pytest.raises(ValueError, match=rf"q: expected shape \(\.\.\., {model.nq}\)"):
         rd.crba(model, np.zeros(model.full.nq))
+    full, column = model.full, model.independent_q.tolist()
+    ball = [column.index(full.idx_q[i]) for i in range(full.nbodies) if full.joint_type[i] == J.SPHERICAL]
+    k = max(ball)  # a spherical joint after a mimic joint: its index differs in the full tree
+    assert full.idx_q[full.joint_type == J.SPHERICAL].max() != k
+    bad = q.copy()
+    bad[k:k + 4] *= 3.0
+    with pytest.raises(ValueError, match=rf"quaternion of spherical joint .* \(q\[{k}:{k + 4}\]\) has norm 3"):
+        rd.rnea(model, bad, v, a)
+
+
+def test_a_coupling_that_overflows_is_a_nonfinite_result():
+    """Finite independent coordinates whose image ``r q + o`` on a mimic joint overflows."""
+    model = MODELS[1]  # joint7 mimics joint1 (q[7]) with multiplier 3.03
+    assert ("joint7", "joint1") == model.mimic[1][:2] and model.mimic[1][2] > 2.0
+    q, v, a = states(model, "overflow")
+    q[7] = 1e308
+    for call in (lambda: rd.rnea(model, q, v, a), lambda: rd.crba(model, q), lambda: rd.aba(model, q, v, a),
+                 lambda: rd.rnea(model, np.stack([q, q]), v, a)):
+        with pytest.raises(ValueError, match="the result is not finite although every input is"):
+            call()
 
 
 def test_a_mass_matrix_that_is_not_positive_definite_is_an_error():

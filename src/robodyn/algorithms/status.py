@@ -112,34 +112,46 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
     if code == NONFINITE_RESULT:
         raise_nonfinite_result(what, arrays)
     if code == BAD_QUATERNION:
-        q = arrays["q"]
-        for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
-            k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
-            n = np.linalg.norm(q[..., k:k + size], axis=-1)
-            if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
-                worst = float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))])
-                kind = J.NAMES[model.joint_type[i]]
-                unit = "quaternion" if size == 4 else "(cos, sin)"
-                raise ValueError(
-                    f"{what}: q: {unit} of {kind} joint {model.body_joint_names[i]!r} (q[{k}:{k + size}]) has norm "
-                    f"{worst:.6g}, not 1 (tolerance {J.QUAT_TOL}); normalise it"
-                )
-        raise AssertionError("kernel reported a bad quaternion that is not there")
+        raise_bad_unit(model, arrays["q"], what)
     return code
+
+
+def raise_bad_unit(model, q: np.ndarray, what: str, column=None) -> None:
+    """Raise the ``ValueError`` of the first quaternion or planar ``(cos, sin)`` of ``q``
+    (..., model.nq) that is not unit; ``column`` maps an index of ``q`` to the caller's (a
+    coupled model's independent coordinates)."""
+    name = (lambda k: k) if column is None else column
+    for i in np.flatnonzero(J.UNIT_SIZE[model.joint_type] > 0):
+        k, size = model.idx_q[i] + J.UNIT_OFFSET[model.joint_type[i]], J.UNIT_SIZE[model.joint_type[i]]
+        n = np.linalg.norm(q[..., k:k + size], axis=-1)
+        if np.any(~(np.abs(n - 1.0) <= J.QUAT_TOL)):
+            worst = float(np.ravel(n)[np.argmax(np.ravel(np.abs(n - 1.0)))])
+            kind = J.NAMES[model.joint_type[i]]
+            unit = "quaternion" if size == 4 else "(cos, sin)"
+            raise ValueError(
+                f"{what}: q: {unit} of {kind} joint {model.body_joint_names[i]!r} (q[{name(k)}:{name(k) + size}]) "
+                f"has norm {worst:.6g}, not 1 (tolerance {J.QUAT_TOL}); normalise it"
+            )
+    raise AssertionError("kernel reported a bad quaternion that is not there")
 
 
 def raise_for_coupled(model, status, arrays: dict, what: str) -> int:
     """:func:`raise_for_status` of a kernel of a model with mimic couplings
     (``robodyn.coupling``): its inputs are the independent coordinates, checked there; a bad
     quaternion is found in the full tree's configuration (free and spherical joints are never
-    mimic joints, so its entries are the caller's)."""
+    mimic joints, so its entries are the caller's, named by their index there); a non-finite
+    input of the full tree from finite independent coordinates is an overflow of ``P q + o``
+    or ``G v``, a non-finite result."""
     if type(status) is not int:
         bad = np.flatnonzero(status)
         status = int(status[bad[0]]) if bad.size else OK
-    if status == BAD_QUATERNION:
-        return raise_for_status(model.full, status, {"q": arrays["q"] @ model.P.T + model.offset}, what)
+    if status == BAD_QUATERNION:  # q[k] of the full tree is q[column[k]] of the caller's
+        column = dict(zip(model.independent_q.tolist(), range(model.nq)))
+        raise_bad_unit(model.full, arrays["q"] @ model.P.T + model.offset, what, column.__getitem__)
     if status == NOT_POSITIVE_DEFINITE:
         raise_not_positive_definite(model, what)
+    if status == NONFINITE and all(np.isfinite(a).all() for a in arrays.values()):
+        raise_nonfinite_result(what, arrays)  # the full tree's state on the coupling overflowed
     return raise_for_status(model, status, arrays, what)
 
 
