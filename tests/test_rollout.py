@@ -218,3 +218,22 @@ def test_a_coupled_model_rolls_out_with_its_own_masses():
         traj = rd.simulate(heavy, q0, np.zeros(model.nv), 0.05, 1e-3, contacts=far, progress=False)
         np.testing.assert_allclose(R.q[b], traj.q, rtol=1e-9, atol=1e-12)
     assert not np.allclose(R.q[0], R.q[1])
+
+
+def test_a_massless_model_with_contacts_is_named():
+    """A mass matrix that is not positive definite (massless bodies, no armature) stops a
+    contact simulation or rollout with an error that says so, for a tree and a coupled model,
+    compiled or driven from Python."""
+    from test_mimic import MODELS
+
+    model = MODELS[0]
+    full = model.full.replace(theta=np.zeros_like(model.full.theta), armature=np.zeros(model.full.nv))
+    coupled = rd.CoupledModel(full, model.mimic)
+    contacts = Contacts([rd.contact.Sphere(1, 0.05)], surfaces=[Plane(height=-0.4)])
+    for m, where in ((full, "mass matrix of .* is not"), (coupled, "mass matrix of .* in its independent coordinates")):
+        q0 = rd.random.random_configuration(m, np.random.default_rng(1))
+        for controller in (None, lambda t, q, v: np.zeros(m.nv)):
+            with pytest.raises(ValueError, match=f"simulate at t = 0: the {where}.*positive definite"):
+                rd.simulate(m, q0, np.zeros(m.nv), 0.01, 1e-3, controller, contacts=contacts, progress=False)
+        with pytest.raises(ValueError, match=f"rollout 0: simulate at t = 0: the {where}.*positive definite"):
+            rd.rollout(m, q0[None], np.zeros(m.nv), 0.01, 1e-3, contacts=contacts)

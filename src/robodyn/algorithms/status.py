@@ -113,6 +113,8 @@ def raise_for_status(model, status, arrays: dict, what: str) -> int:
         raise_nonfinite_result(what, arrays)
     if code == BAD_QUATERNION:
         raise_bad_unit(model, arrays["q"], what)
+    if code == NOT_POSITIVE_DEFINITE:
+        raise_not_positive_definite(model, what, "")
     return code
 
 
@@ -155,10 +157,11 @@ def raise_for_coupled(model, status, arrays: dict, what: str) -> int:
     return raise_for_status(model, status, arrays, what)
 
 
-def raise_not_positive_definite(model, what: str):
-    """Raise the ``ValueError`` of a coupled model whose mass matrix in its independent
-    coordinates is not positive definite (a mimic joint that moves no mass, say)."""
-    raise ValueError(f"{what}: the mass matrix of {model.name!r} in its independent coordinates is not "
+def raise_not_positive_definite(model, what: str, coordinates: str = " in its independent coordinates"):
+    """Raise the ``ValueError`` of a mass matrix that is not positive definite: a coupled
+    model's in its independent coordinates (a mimic joint that moves no mass, say), or a
+    tree's (``coordinates=""``)."""
+    raise ValueError(f"{what}: the mass matrix of {model.name!r}{coordinates} is not "
                      "positive definite, so the forward dynamics is undefined; give the bodies the joints "
                      "move mass and inertia (or armature)")
 

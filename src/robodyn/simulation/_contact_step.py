@@ -19,7 +19,7 @@ from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.dense import backward, cholesky, forward
 from ..algorithms.rnea import rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..algorithms.status import CHECKED, NONFINITE_RESULT, OK, finite
+from ..algorithms.status import CHECKED, NONFINITE_RESULT, NOT_POSITIVE_DEFINITE, OK, finite
 from ..contact.solver import (ACTIVE, BODY, BODY_SPHERE, BOUNCE_SPEED, FRICTION, ITERATIONS, KIND, MARGIN,
                               MAX_CORRECTION, MAX_ITERATIONS, RESIDUAL, RESTITUTION, STABILIZATION, TOLERANCE,
                               contact_frame, delassus, point_rows, solve, surface_distance)
@@ -246,7 +246,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, s
     if st != OK:
         return st
     if not cholesky(M):
-        return NONFINITE_RESULT
+        return NOT_POSITIVE_DEFINITE
     for k in range(nv):
         tmp[k] = tau[k] - h[k]
     forward(M, tmp)

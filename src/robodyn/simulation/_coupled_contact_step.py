@@ -22,7 +22,7 @@ import numpy as np
 from .._jit import core, kernel
 from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.rnea import workspace as rnea_workspace
-from ..algorithms.status import NONFINITE_RESULT, OK
+from ..algorithms.status import NOT_POSITIVE_DEFINITE, OK
 from ..algorithms.dense import backward, cholesky, forward
 from ._contact_step import (contact_forces, contact_rows, contact_velocity, dynamics_terms, moving_frame_terms,
                             next_state, pair_workspace)
@@ -61,7 +61,7 @@ def step(ints, body, dofs, params, fext, fcode, limit, cmap, cscale, independent
         for j in range(nf):
             Mr[cmap[k], cmap[j]] += cscale[k] * cscale[j] * M[k, j]
     if not cholesky(Mr):
-        return NONFINITE_RESULT
+        return NOT_POSITIVE_DEFINITE
     forward(Mr, tau_r)
     backward(Mr, tau_r)
     for k in range(nf):

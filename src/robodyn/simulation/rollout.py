@@ -166,7 +166,7 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
         b = int(bad[0])
         s, k = int(failed[b]), int(failed[b]) // every
         try:
-            raise_at(tree, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k])
+            raise_at(tree, int(status[b]), s * dt, Q[b, k], V[b, k], T[b, k], is_coupled(model))
         except ValueError as e:
             raise ValueError(f"rollout {b}: {e}") from None
     t = np.arange(0, n + 1, every) * dt

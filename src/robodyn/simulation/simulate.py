@@ -23,7 +23,7 @@ from .._deprecated import renamed_keyword
 from .. import joints as J
 from ..coupling import is_coupled, joint_tree
 from ..algorithms.rnea import external_wrenches, rnea
-from ..algorithms.status import OK, raise_for_status
+from ..algorithms.status import NOT_POSITIVE_DEFINITE, OK, raise_for_status, raise_not_positive_definite
 from ..contact import solver as CS
 from ..control.laws import CONSTANT
 from ..errors import RobodynWarning, user_stacklevel
@@ -204,8 +204,12 @@ class _Plant:
         self.rate(q, theta, v, thetadot)
 
 
-def raise_at(model, status, t, q, v, tau):
-    """The error of an ABA status at time ``t``."""
+def raise_at(model, status, t, q, v, tau, coupled: bool = False):
+    """The error of a step's status at time ``t`` (``coupled``: the step of a model with mimic
+    couplings on its full tree ``model``)."""
+    if status == NOT_POSITIVE_DEFINITE:
+        raise_not_positive_definite(model, f"simulate at t = {t:.6g}", " in its independent coordinates" if coupled
+                                    else "")
     try:
         bad = raise_for_status(model, status, {"q": q, "v": v, "tau (controller output)": tau},
                                f"simulate at t = {t:.6g}")
@@ -497,7 +501,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
                             V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
                             touch.info[a:b + 1], warm, *extra)
             if status != OK:
-                raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s])
+                raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s], coupling is not None)
             bar.update(b)
     else:
         step, ws, extra = CK.step_kernel, CK.workspace(model.nbodies, nv, len(names)), ()
@@ -514,7 +518,7 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
             status = step(*plant.args_at(t[s], q, v), *extra, *geometry, q, v, cmd, dt, T[s], A[s], qn, vn,
                           touch.force[s], touch.geometry[s], warm, touch.info[s], ws)
             if status != OK:
-                raise_at(model, status, t[s], q, v, cmd)
+                raise_at(model, status, t[s], q, v, cmd, coupling is not None)
             if s < n:
                 Z[s + 1] = z + dt * zdot
             if s % every == 0:
