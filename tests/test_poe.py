@@ -63,6 +63,9 @@ def test_generalized_inertia_matrices_and_a_helical_joint():
     assert screw.joint_type.tolist() == [rd.joints.HELICAL] and screw.joint_pitch.tolist() == [pytest.approx(0.05)]
     T = rd.frame_pose(screw, np.array([np.pi / 2]), "link1")
     assert_rel(T[:3, 3], [0.0, 0.0, 0.05 * np.pi / 2], 1e-12)
+    # rounding in a computed twist (w . v ~ 1e-20, far below the axis tolerance): no pitch
+    noisy = rd.from_poe([[1.0, 0.0, 1e-20, 0.0, 0.0, 1.0]], [np.eye(4)], [(1.0, (0.1, 0, 0), 0.01 * np.eye(3))])
+    assert noisy.joint_type.tolist() == [rd.joints.REVOLUTE] and noisy.joint_pitch.tolist() == [0.0]
 
 
 def test_a_urdf_robot_from_twists():

@@ -67,6 +67,7 @@ def poe_tree(twists, home, parents=None, where: str = "from_poe"):
             on_axis = ops.cross(w, v)                   # the point of the axis nearest the base origin
             origin = on_axis + w * ops.dot(w, p - on_axis)  # ... and nearest the link frame's origin
             kind = "revolute" if (pitch == 0 if ops.symbolic else abs(pitch) <= AXIS_TOL) else "helical"
+            pitch = pitch if kind == "helical" else 0  # rounding (|w . v| ~ 1e-34) is no pitch
             axis = w
         frames.append((R, origin))
         parent = parents[i]
