@@ -569,7 +569,10 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
         a: (..., nv), the inverse of :func:`robodyn.rnea`: ``aba(q, v, rnea(q, v, a)) == a``.
 
     Raises ValueError when a body's articulated inertia is singular (e.g. a chain of massless
-    leaf bodies): the forward dynamics is undefined there. Reference: RBDA Table 7.1.
+    leaf bodies), or, for a model with mimic couplings (:class:`robodyn.CoupledModel`, solved
+    as ``(G^T M G)^-1 G^T (tau_full - h)``), when its mass matrix in the independent
+    coordinates is not positive definite: the forward dynamics is undefined there.
+    Reference: RBDA Table 7.1.
     """
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba()")

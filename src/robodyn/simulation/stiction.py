@@ -106,16 +106,16 @@ def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_abov
 
     With ``coupling`` (a :class:`~robodyn.coupling.CoupledModel` whose ``full`` is ``model``,
     stepped by ``plant`` under its couplings) the friction is solved in the independent
-    coordinates: a dof ``k`` of the tree moves as ``G[k, i] v_i`` with one independent
+    coordinates: a dof ``k`` of the tree moves as ``E[k, i] v_i`` with one independent
     coordinate ``i``, so the dry friction the tree's dofs put on ``i`` is any torque of
-    magnitude up to ``sum_k |G[k, i]| F_k(v_k)`` (the box of each independent coordinate),
+    magnitude up to ``sum_k |E[k, i]| F_k(v_k)`` (the box of each independent coordinate),
     with the coupled model's ``M^-1``; ``friction`` holds it in the columns of the independent
-    dofs."""
+    dofs. (``E`` is the coupling's ``G``; here ``G`` names the Delassus matrix.)"""
     nv, nz = V.shape[1], Z.shape[1]
     n = Q.shape[0] - 1
     zero, thetadot, vdot = np.zeros(nv), np.empty(nv), np.empty(nv)
-    G = np.eye(nv) if coupling is None else coupling.G  # v = G v_r
-    dry = np.flatnonzero(np.abs(G).T @ ((model.coulomb > 0) | (model.stribeck > 0)))
+    E = np.eye(nv) if coupling is None else coupling.G  # v = E v_r
+    dry = np.flatnonzero(np.abs(E).T @ ((model.coulomb > 0) | (model.stribeck > 0)))
     columns = dry if coupling is None else coupling.independent_v[dry]
     friction, residual = np.zeros((n + 1, nv)), np.zeros(n + 1)
     zdot = np.empty(nz)
@@ -134,14 +134,14 @@ def run_stiction(model, plant, law, q0, v0, dt, t, Q, V, Z, A, T, bar, warn_abov
                 Minv = inverse_mass_matrix(coupling, q[coupling.independent_q])
                 v_free_r = v_free[coupling.independent_v]
             W = dt * Minv[np.ix_(dry, dry)]
-            bound = (np.abs(G).T @ friction_bound(model, v))[dry]
+            bound = (np.abs(E).T @ friction_bound(model, v))[dry]
             sol = box_friction(W, v_free_r[dry], bound, f_dry)
             f_dry, residual[s] = sol.f, sol.residual
             friction[s, columns] = f_dry
             v_next_r = v_free_r - dt * (Minv[:, dry] @ f_dry)
             stuck = np.abs(f_dry) < bound
             v_next_r[dry[stuck]] = 0.0  # at rest exactly (the solve leaves rounding there)
-            v_next = G @ v_next_r
+            v_next = E @ v_next_r
         A[s] = (v_next - v) / dt
         if s == n:
             break
