@@ -10,6 +10,7 @@ from scipy.spatial.transform import Rotation
 
 import robodyn as rd
 from conftest import small_tree_builder
+from helpers import assert_rel
 from robodyn import joints as J
 from robodyn.builder import rpy_to_matrix
 from robodyn.model import inertial_parameters_from
@@ -115,8 +116,41 @@ def test_cycle_below_a_branch_names_only_the_cycle():
 
 
 def test_physical_argument():
-    with pytest.raises(ValueError, match="physical must be 'error' or 'warn'"):
+    with pytest.raises(ValueError, match="physical must be 'error', 'warn' or 'repair'"):
         rd.ModelBuilder(physical="maybe")
+
+
+def test_physical_repair_of_merged_bodies():
+    """A body merged from links by fixed joints is judged and repaired as one: the warning
+    names the body and its links; the model's other bodies are untouched and it checks them
+    as physical="error" does."""
+    def build(physical):
+        b = rd.ModelBuilder("r", source="s", physical=physical)
+        b.add_link("base")
+        b.add_link("arm", mass=1.0, inertia=np.diag([0.1, 0.1, 0.5]))
+        b.add_link("tip", mass=1e-3)
+        b.add_link("hand", mass=1.0, com=(0.1, 0, 0), inertia=np.diag([0.01, 0.02, 0.025]))
+        b.add_joint("j1", "revolute", "base", "arm", axis=(0, 0, 1))
+        b.add_joint("f", "fixed", "arm", "tip", xyz=(0.5, 0, 0))
+        b.add_joint("j2", "revolute", "arm", "hand", xyz=(1, 0, 0), axis=(0, 1, 0))
+        return b.build()
+
+    with pytest.raises(rd.ModelError, match="body 'arm' \\(links 'arm', 'tip' merged by fixed joints\\).*"
+                                            "physical='repair' to repair it"):
+        build("error")
+    with pytest.warns(rd.RobodynWarning, match="s: body 'arm' \\(links 'arm', 'tip' merged by fixed joints\\): "
+                                               "principal moments of inertia .* repaired to .*; it was: principal "
+                                               "moments"):
+        model = build("repair")
+    assert model.physical == "error"
+    m, c, I = rd.model.mass_com_inertia(model.theta[0])
+    assert m == pytest.approx(1.001) and c == pytest.approx([0.5e-3 / 1.001, 0, 0])
+    eig = np.linalg.eigvalsh(I)
+    np.testing.assert_allclose(eig, eig.mean(), rtol=1e-13)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        np.testing.assert_array_equal(model.theta[1], build("warn").theta[1])
+        assert_rel(eig.sum(), np.trace(rd.model.mass_com_inertia(build("warn").theta[0])[2]), 1e-13)
 
 
 # ----------------------------------------------------------------------------------------

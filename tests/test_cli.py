@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import pathlib
 import re
 import sys
 
@@ -212,3 +213,16 @@ def test_a_free_simulation_moves(capsys):
     model = rd.models.load("pendulum")
     assert start == pytest.approx(float(rd.potential_energy(model, np.array([0.5]))), rel=1e-5)
     assert drift < 1e-8 * abs(start)
+
+
+def test_physical_option(capsys):
+    """--physical: an unphysical body is refused (the message names the options), kept with
+    'warn', repaired with 'repair' (the warning gives the moments before and after)."""
+    urdf = str(pathlib.Path(__file__).parent / "fixtures" / "triangle_inequality.urdf")
+    code, _, err = run(capsys, "info", urdf)
+    assert code != 0 and "physical='repair'" in err and "Traceback" not in err
+    with pytest.warns(rd.RobodynWarning, match=r"\[0.1, 0.1, 0.5\] repaired to \[0.233333, 0.233333, 0.233333\]"):
+        code, out, _ = run(capsys, "info", urdf, "--physical", "repair")
+    assert code == 0 and "nq=1, nv=1" in out
+    with pytest.warns(rd.RobodynWarning, match="kept as given"):
+        assert run(capsys, "info", urdf, "--physical", "warn")[0] == 0

@@ -321,7 +321,7 @@ def test_missing_pinocchio_names_the_package(monkeypatch):
 def test_bad_inputs():
     with pytest.raises(TypeError, match="expected a pinocchio.Model, got Model"):
         from_pinocchio(rd.models.load("double_pendulum"))
-    with pytest.raises(ValueError, match="physical must be 'error' or 'warn'"):
+    with pytest.raises(ValueError, match="physical must be 'error', 'warn' or 'repair'"):
         from_pinocchio(pin.Model(), physical="ignore")
     with pytest.raises(ValueError, match="depth-first"):  # parents [-1, 0, 0, 0, 3, 1, 5]
         to_pinocchio(rd.random.random_model(6, seed=5, floating_base=True))
@@ -339,6 +339,11 @@ def test_unphysical_inertia_and_rotor_inertia():
     with pytest.warns(rd.RobodynWarning, match=r"body 0 \('j', joint 'j'\).*triangle inequality.*kept as given"):
         model = from_pinocchio(pm, physical="warn")
     assert model.theta[0, 9] == 3.0
+    with pytest.warns(rd.RobodynWarning, match=r"body 0 \('j', joint 'j'\).*triangle inequality.*\[1, 1, 3\] "
+                                               r"repaired to \[1.66667, 1.66667, 1.66667\]"):
+        model = from_pinocchio(pm, physical="repair")
+    np.testing.assert_allclose(model.theta[0, [4, 6, 9]], 5.0 / 3.0, rtol=1e-14)
+    assert model.physical == "error"
     pm.inertias[j] = pin.Inertia(1.0, np.zeros(3), np.eye(3))
     pm.rotorInertia = np.array([0.5])
     with pytest.warns(rd.RobodynWarning, match=r"rotorInertia \[0.5\] not converted"):

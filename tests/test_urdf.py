@@ -16,6 +16,7 @@ from scipy.spatial.transform import Rotation
 import robodyn as rd
 import robodyn.io.urdf as urdf_module
 from robodyn import joints
+from helpers import assert_rel
 from conftest import assert_names_line, erd_id, example_robot_urdfs, marked_lines, rot
 
 # ----------------------------------------------------------------------------------------
@@ -288,6 +289,80 @@ def test_unphysical_example_robot_data_refused_then_loaded_with_warning(rel):
                   if "kept as given" in str(w.message)]
         assert warned == [b for b, _ in _unphysical(path, floating_base)]
         assert model.physical == "warn"
+
+
+@pytest.mark.parametrize("rel", sorted(UNPHYSICAL))
+def test_unphysical_example_robot_data_repaired(rel):
+    """physical="repair" makes each unphysical body consistent, with a warning naming it and
+    its principal moments before and after: negative moments raised to 0, then all three set
+    to their mean where I1 + I2 >= I3 fails (MuJoCo's balanceinertia); mass, centre of mass and
+    principal axes kept, every other body as in the file. Where the file only violates the
+    triangle inequality, MuJoCo compiling the file's bodies with balanceinertia="true" has the
+    repaired model's dynamics."""
+    path = next(p for p in ALL_URDFS if erd_id(p) == rel)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        kept = rd.load_urdf(path, physical="warn", mimic="independent")
+    with pytest.warns(rd.RobodynWarning) as record:
+        model = rd.load_urdf(path, physical="repair", mimic="independent")
+    notes = {re.match(r".*?: body '([^']+)'", str(w.message)).group(1): str(w.message) for w in record
+             if "repaired to" in str(w.message)}
+    assert list(notes) == [b for b, _ in _unphysical(path, False)]
+    assert model.physical == "error" and rd.model.consistent_inertial_parameters(model.theta).all()
+    only_triangle = True
+    for i, name in enumerate(model.link_names):
+        if name not in notes:
+            np.testing.assert_array_equal(model.theta[i], kept.theta[i], err_msg=name)
+            continue
+        m0, c0, I0 = rd.model.mass_com_inertia(kept.theta[i])
+        m1, c1, I1 = rd.model.mass_com_inertia(model.theta[i])
+        before, V = np.linalg.eigh(I0)
+        expected = np.maximum(before, 0.0)
+        if expected[0] + expected[1] < expected[2]:
+            expected[:] = expected.mean()
+        only_triangle &= bool(before[0] >= 0)
+        assert m1 == m0 and np.allclose(c1, c0, rtol=1e-12, atol=0.0), name
+        assert_rel(V.T @ I1 @ V, np.diag(expected), 1e-12, f"{name}: the moments in the same axes")
+        assert f"{before[0]:.6g}" in notes[name] and f"repaired to [{expected[0]:.6g}" in notes[name]
+    if only_triangle:
+        import mujoco
+        from test_mjcf import compare_with_mujoco
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rd.RobodynWarning)
+            text = rd.write_mjcf(kept).replace("<compiler ", '<compiler balanceinertia="true" ', 1)
+        compare_with_mujoco(model, mujoco.MjModel.from_xml_string(text), label=lambda model, site: site)
+
+
+def test_repair_of_one_body():
+    """The rule on single bodies: a consistent body unchanged, a negative moment raised to 0
+    (when the triangle inequality then holds, nothing else), a massless body with an inertia
+    emptied; a negative mass cannot be repaired. ``Model(physical="repair")`` and the CLI take
+    the option too."""
+    repair = rd.model.repaired_inertial_parameters
+    ok = rd.model.inertial_parameters_from(2.0, (0.1, 0.2, 0.3), np.diag([1.0, 2.0, 2.5]))
+    np.testing.assert_array_equal(repair(ok)[0], ok)
+    R = Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix()
+    flat = rd.model.inertial_parameters_from(2.0, (0.1, 0.2, 0.3), R @ np.diag([-0.01, 1.0, 1.0]) @ R.T)
+    fixed, before, after = repair(flat)
+    assert_rel(after, [0.0, 1.0, 1.0], 1e-12)
+    assert_rel(fixed, rd.model.inertial_parameters_from(2.0, (0.1, 0.2, 0.3), R @ np.diag([0.0, 1.0, 1.0]) @ R.T),
+               1e-12)
+    ghost = np.array([0.0, 0, 0, 0, 1e-6, 0, 1e-6, 0, 0, 1e-6])
+    np.testing.assert_array_equal(repair(ghost)[0], np.zeros(10))
+    with pytest.raises(rd.ModelError, match="cannot be repaired"):
+        repair(np.r_[-1.0, np.zeros(9)])
+    model = rd.models.load("double_pendulum")
+    theta = model.theta.copy()
+    theta[1] = flat
+    with pytest.warns(rd.RobodynWarning, match=r"body 1 \('.*'\): principal moments of inertia \[-0.01, 1, 1\] "
+                                               r"repaired to \[0, 1, 1\] \(negative principal moments raised to 0;"):
+        repaired = model.replace(theta=theta, physical="repair")
+    assert repaired.physical == "error"
+    assert_rel(repaired.theta[1], fixed, 0.0)
+    np.testing.assert_array_equal(repaired.theta[0], model.theta[0])
+    with pytest.raises(ValueError, match="physical must be 'error', 'warn' or 'repair'"):
+        model.replace(physical="fix")
 
 
 @pytest.mark.parametrize("rel", sorted(PLACEHOLDERS))

@@ -37,9 +37,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import joints as J
-from .errors import RobodynWarning
+from .errors import RobodynWarning, user_stacklevel
 from .model import (Model, ModelError, check_inertial_parameters, consistent_inertial_parameters,
-                    inertial_parameters_from)
+                    inertial_parameters_from, repair_note, repaired_inertial_parameters)
 
 WORLD = "world"  # a joint's parent link of this name needs no add_link: the fixed root
 JOINT_TYPES = {"revolute": J.REVOLUTE, "continuous": J.REVOLUTE, "prismatic": J.PRISMATIC, "free": J.FREE,
@@ -154,9 +154,11 @@ class ModelBuilder:
                  physical: str = "error"):
         """``physical="error"`` rejects unphysical link inertias with a :class:`ModelError`;
         ``physical="warn"`` keeps them as given and warns (for descriptions known to carry
-        such values, e.g. some published URDFs)."""
-        if physical not in ("error", "warn"):
-            raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+        such values, e.g. some published URDFs); ``physical="repair"`` makes each such body
+        consistent and warns by how much (:func:`robodyn.model.repaired_inertial_parameters`:
+        negative principal moments raised to 0, then MuJoCo's ``balanceinertia`` rule)."""
+        if physical not in ("error", "warn", "repair"):
+            raise ValueError(f"physical must be 'error', 'warn' or 'repair', got {physical!r}")
         self.physical = physical
         self.name = name
         self.gravity = np.asarray(gravity, dtype=float)
@@ -204,15 +206,16 @@ class ModelBuilder:
         self._links[name] = entry
         self._pending_links.append((entry, mass, com, inertia, rpy))
 
-    def _check_body(self, theta, name: str, links: list[LinkEntry]) -> None:
+    def _check_body(self, theta, name: str, links: list[LinkEntry]) -> np.ndarray:
         """Check the merged body ``name`` (``theta``), made of ``links``; raise (or warn, with
-        ``physical="warn"``) naming each link and what it carries."""
+        ``physical="warn"``) naming each link and what it carries. Returns its parameters:
+        ``theta``, or with ``physical="repair"`` the repaired ones."""
         where = f"{self.source}: body {name!r}"
         if len(links) > 1:
             where += f" (links {', '.join(repr(k.name) for k in links)} merged by fixed joints)"
         try:
             check_inertial_parameters(theta, where)
-            return
+            return theta
         except ModelError as e:
             message = str(e)
         parts = []
@@ -225,10 +228,17 @@ class ModelBuilder:
             alone = issue[len(k_where) + 2:] if issue else ""
             parts.append(f"{place}: mass {m:.6g}, com {com}" + (f", alone: {alone}" if alone else ""))
         message += "; made of " + "; ".join(parts)
+        if self.physical == "repair":
+            repaired, before, after = repaired_inertial_parameters(theta)
+            warnings.warn(f"{where}: {repair_note(before, after, theta[0])}; it was: {message[len(where) + 2:]}",
+                          RobodynWarning, stacklevel=user_stacklevel())
+            return repaired
         if self.physical == "warn":
             warnings.warn(f"{message}; kept as given (physical='warn')", RobodynWarning, stacklevel=3)
+            return theta
         else:
-            raise ModelError(f"{message} (load with physical='warn' to keep it anyway)")
+            raise ModelError(f"{message} (load with physical='warn' to keep it anyway, or physical='repair' to "
+                             "repair it)")
 
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
@@ -521,7 +531,7 @@ class ModelBuilder:
             np.add.at(theta, [body_of[link] for link in on_body], terms)
         suspect = ~consistent_inertial_parameters(theta) if nb else []
         for i in np.flatnonzero(suspect):
-            self._check_body(theta[i], names[i], members[i])
+            theta[i] = self._check_body(theta[i], names[i], members[i])
 
         # The model's arrays: bodies (X_tree, axis, limits per dof) and frames
         jtype, parent, axis, pitch, jnames, dofs = [], [], [], [], [], []
@@ -555,7 +565,7 @@ class ModelBuilder:
         return Model(
             parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)), joint_pitch=pitch,
             X_tree_R=X_R, X_tree_p=X_p, theta=theta, link_names=names, body_joint_names=jnames,
-            physical=self.physical, gravity=self.gravity, lower=col["lower"], upper=col["upper"],
+            physical="error" if self.physical == "repair" else self.physical, gravity=self.gravity, lower=col["lower"], upper=col["upper"],
             velocity_limit=col["velocity"], effort_limit=col["effort"], damping=col["damping"],
             coulomb=col["friction"], armature=col["armature"], stiffness=col["stiffness"],
             spring_reference=col["spring_reference"], frame_names=[f[0] for f in frames],

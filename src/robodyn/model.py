@@ -17,6 +17,7 @@ Inertial parameters, 10 per body about the body frame origin in the body frame:
 
 from __future__ import annotations
 
+import warnings
 from typing import Sequence
 
 import numpy as np
@@ -25,7 +26,7 @@ from ._deprecated import renamed_attribute, renamed_keyword
 from . import joints as J
 
 
-from .errors import ModelError
+from .errors import ModelError, RobodynWarning, user_stacklevel
 from .layout import pack
 
 
@@ -107,7 +108,7 @@ def check_inertial_parameters(theta, where: str) -> None:
     c = theta[1:4] / m
     Ic = Io - m * (np.dot(c, c) * np.eye(3) - np.outer(c, c))
     eig = np.linalg.eigvalsh(Ic)
-    tol = max(INERTIA_RTOL * np.abs(eig).max(), 1e-12 * scale, INERTIA_ATOL)
+    tol = inertia_tolerance(eig, scale)
     if eig[0] < -tol:
         raise ModelError(
             f"{where}: inertia about the centre of mass is not positive semi-definite "
@@ -118,6 +119,50 @@ def check_inertial_parameters(theta, where: str) -> None:
             f"{where}: principal moments of inertia {eig.tolist()} violate the triangle "
             "inequality I1 + I2 >= I3"
         )
+
+
+def repair_note(before, after, mass: float) -> str:
+    """The warning text of a repaired body (:func:`repaired_inertial_parameters`)."""
+    if mass == 0:
+        return "massless with a first moment or inertia: its inertial parameters set to 0 (physical='repair')"
+    steps = (["negative principal moments raised to 0"] if before[0] < 0 else []) + \
+        (["I1 + I2 >= I3 failing, all three set to their mean"] if np.ptp(after) == 0 < np.ptp(before) else [])
+    fmt = lambda e: "[" + ", ".join(f"{x:.6g}" for x in e) + "]"  # noqa: E731
+    return (f"principal moments of inertia {fmt(before)} repaired to {fmt(after)} ({'; '.join(steps)}; mass, "
+            "centre of mass and principal axes kept; physical='repair')")
+
+
+def inertia_tolerance(eig, scale: float) -> float:
+    """The tolerance of the principal-moment tests: ``INERTIA_RTOL`` of the largest moment,
+    at least ``1e-12`` of ``scale`` (the largest entry about the frame origin) and
+    ``INERTIA_ATOL``."""
+    return max(INERTIA_RTOL * np.abs(eig).max(), 1e-12 * scale, INERTIA_ATOL)
+
+
+def repaired_inertial_parameters(theta) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(theta', before, after)``: a consistent body near ``theta`` (finite, mass >= 0),
+    with the principal moments about the centre of mass before and after.
+
+    Mass and centre of mass are kept, and so are the principal axes. Negative principal
+    moments are raised to 0 (positive semi-definite); then, when ``I1 + I2 >= I3`` still fails
+    (beyond the tolerance of :func:`check_inertial_parameters`), all three become their mean,
+    the rule of MuJoCo's ``<compiler balanceinertia="true">``. A massless body keeps no first
+    moment and no inertia (all ten parameters 0). A consistent ``theta`` comes back unchanged.
+    """
+    theta = np.asarray(theta, dtype=float)
+    if not (np.all(np.isfinite(theta)) and theta[0] >= 0):
+        raise ModelError(f"inertial parameters {theta.tolist()} (not finite, or a negative mass) cannot be repaired")
+    m, c, Ic = mass_com_inertia(theta)
+    eig, V = np.linalg.eigh(Ic)
+    if m == 0:
+        return np.zeros(10), eig, np.zeros(3)
+    tol = inertia_tolerance(eig, max(np.abs(inertia_about_origin(theta)).max(), 1e-300))
+    if eig[0] >= -tol and eig[0] + eig[1] >= eig[2] - tol:
+        return theta.copy(), eig, eig
+    moments = np.maximum(eig, 0.0)
+    if moments[0] + moments[1] < moments[2] - tol:
+        moments[:] = moments.mean()
+    return inertial_parameters_from(m, c, (V * moments) @ V.T), eig, moments
 
 
 def consistent_inertial_parameters(theta) -> np.ndarray:
@@ -159,6 +204,11 @@ class Model:
     or N/m; joints of one dof only). Frames (nf): ``frame_names``,
     ``frame_body`` (-1 for the world), ``frame_R`` (nf, 3, 3), ``frame_p`` (nf, 3).
     ``gravity`` (3,) in the world frame.
+
+    ``physical``: ``"error"`` (default) refuses a body no rigid body can be (inertia about the
+    centre of mass not positive semi-definite or violating ``I1 + I2 >= I3``, an inertia
+    without mass); ``"warn"`` keeps it; ``"repair"`` repairs it with a warning
+    (:func:`repaired_inertial_parameters`), and the model is then ``physical="error"``.
     """
 
     __slots__ = (
@@ -250,6 +300,13 @@ class Model:
         jnames = list(body_joint_names)
         if len(names) != nb or len(jnames) != nb:
             raise ModelError(f"link_names and body_joint_names need {nb} entries")
+        if physical == "repair":  # the bodies no rigid body can have, made consistent (with a warning)
+            fixable = np.isfinite(theta).all(1) & (theta[:, 0] >= 0) if nb else np.zeros(0, bool)
+            for i in np.flatnonzero(fixable & ~consistent_inertial_parameters(theta)):
+                theta[i], before, after = repaired_inertial_parameters(theta[i])
+                warnings.warn(f"body {i} ({names[i]!r}): {repair_note(before, after, theta[i][0])}",
+                              RobodynWarning, stacklevel=user_stacklevel())
+            physical = "error"
         # every body checked at once; the bodies that fail are checked again one by one, in
         # order, for the message
         finite = np.isfinite(axis).all(1) & np.isfinite(R).reshape(nb, 9).all(1) & np.isfinite(p).all(1)
@@ -342,7 +399,7 @@ class Model:
             raise ModelError("duplicate joint names")
 
         if physical not in ("error", "warn"):
-            raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+            raise ValueError(f"physical must be 'error', 'warn' or 'repair', got {physical!r}")
         setattr_(self, "physical", physical)
         setattr_(self, "name", str(name))
         setattr_(self, "parent", readonly(parent, np.int64))

@@ -40,8 +40,9 @@ def add_model_arguments(p, default=None) -> None:
     """The model argument and the loader options of a command."""
     p.add_argument("model", nargs="?", default=default, help="built-in robot name, URDF path or MJCF path (.xml)")
     p.add_argument("--floating-base", action="store_true", help="URDF: add a free-flying base")
-    p.add_argument("--physical", choices=("error", "warn"), default="error",
-                   help="reject (error) or keep with a warning (warn) unphysical inertias")
+    p.add_argument("--physical", choices=("error", "warn", "repair"), default="error",
+                   help="reject (error), keep with a warning (warn) or repair with a warning (repair: negative "
+                        "principal moments to 0, then MuJoCo's balanceinertia) unphysical inertias")
     p.add_argument("--mimic", choices=("couple", "independent"), default="couple",
                    help="URDF <mimic> joints and MJCF joint equalities: follow their source joint (couple) "
                    "or move as independent joints")

@@ -54,7 +54,7 @@ import numpy as np
 from .. import joints as J
 from ..errors import ModelError, RobodynWarning, user_stacklevel
 from ..coupling import CoupledModel, is_coupled
-from ..model import Model, check_inertial_parameters, inertia_about_origin
+from ..model import Model, check_inertial_parameters, inertia_about_origin, repair_note, repaired_inertial_parameters
 
 # Pinocchio's "unbounded" (the default of its limits) is the largest double.
 _BIG = np.finfo(float).max
@@ -350,7 +350,8 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model | CoupledMode
 
     The Pinocchio order is kept as it is (``ModelBuilder`` would reorder a tree depth first).
     ``physical="error"`` rejects bodies whose inertia no rigid body can have (``ModelError``),
-    ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, as ``load_urdf``.
+    ``"warn"`` keeps them with a :class:`~robodyn.errors.RobodynWarning`, ``"repair"`` repairs
+    them with one, as ``load_urdf``.
 
     Mimic joints (``JointModelMimic``, e.g. ``buildModelFromUrdf(..., mimic=True)``) make a
     :class:`~robodyn.coupling.CoupledModel`: its tree has the mimic joints as ordinary joints
@@ -366,8 +367,8 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model | CoupledMode
     pin = _import_pinocchio("from_pinocchio")
     if not isinstance(pin_model, pin.Model):
         raise TypeError(f"from_pinocchio: expected a pinocchio.Model, got {type(pin_model).__name__}")
-    if physical not in ("error", "warn"):
-        raise ValueError(f"physical must be 'error' or 'warn', got {physical!r}")
+    if physical not in ("error", "warn", "repair"):
+        raise ValueError(f"physical must be 'error', 'warn' or 'repair', got {physical!r}")
     pm = pin_model
     source = f"from_pinocchio(model {pm.name!r})"
     joints = range(1, pm.njoints)
@@ -379,8 +380,13 @@ def from_pinocchio(pin_model, *, physical: str = "error") -> Model | CoupledMode
             check_inertial_parameters(t, f"{source}: body {i} ({names[i]!r}, joint {pm.names[i + 1]!r})")
         except ModelError as e:
             if physical == "error":
-                raise ModelError(f"{e} (convert with physical='warn' to keep it anyway)") from None
-            warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=2)
+                raise ModelError(f"{e} (convert with physical='warn' to keep it anyway, or physical='repair' to "
+                                 "repair it)") from None
+            if physical == "repair":
+                theta[i], before, after = repaired_inertial_parameters(t)
+                warnings.warn(f"{e}; {repair_note(before, after, t[0])}", RobodynWarning, stacklevel=2)
+            else:
+                warnings.warn(f"{e}; kept as given (physical='warn')", RobodynWarning, stacklevel=2)
     body_of = {0: -1}  # Pinocchio joint -> the robodyn body carrying its inertia
     bodies = dict(parent=[], jtype=[], axis=[], pitch=[], R=[], p=[], theta=[], link=[], joint=[])
 

@@ -208,7 +208,11 @@ def load_urdf(source, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), *,
     layout in :mod:`robodyn.model`). Raises :class:`ModelError` for malformed or unphysical
     descriptions; warns (:class:`RobodynWarning`) about what it ignores. Some published URDFs
     carry inertias that no rigid body can have (violating ``I1 + I2 >= I3``, say);
-    ``physical="warn"`` loads them as given with a warning naming each such link.
+    ``physical="warn"`` loads them as given with a warning naming each such link;
+    ``physical="repair"`` makes each such body consistent, as MuJoCo's compiler does with
+    ``balanceinertia``, with a warning giving its principal moments before and after
+    (:func:`robodyn.model.repaired_inertial_parameters`: negative moments raised to 0, then all
+    three set to their mean where ``I1 + I2 >= I3`` fails; mass, centre of mass and axes kept).
 
     The children of a link are ordered by joint name (as urdfdom does), so bodies and ``v``
     follow the order Pinocchio gives the same file.
