@@ -337,6 +337,19 @@ def test_compiler_inertia_options(head):
     check(xml, seed=2)
 
 
+def test_physical_repair_is_balanceinertia():
+    """An MJCF body violating I1 + I2 >= I3 without balanceinertia: refused, and with
+    physical="repair" the model that balanceinertia="true" gives (and MuJoCo compiles)."""
+    xml = _mjcf('<body name="a"><joint axis="0 1 0"/><inertial pos="0.1 0 0" mass="1" diaginertia="0.2 0.01 0.01" '
+                'euler="10 20 0"/></body>')
+    with pytest.raises(rd.ModelError, match="body 'a'.*triangle inequality.*physical='repair'"):
+        rd.load_mjcf(xml)
+    with pytest.warns(rd.RobodynWarning, match=r"\[0.01, 0.01, 0.2\] repaired to \[0.0733333, 0.0733333, 0.0733333\]"):
+        repaired = rd.load_mjcf(xml, physical="repair")
+    balanced = xml.replace("<worldbody>", '<compiler balanceinertia="true"/><worldbody>', 1)
+    np.testing.assert_allclose(repaired.theta, check(balanced).theta, rtol=1e-14, atol=1e-16)
+
+
 def test_inertia_from_geoms_off():
     """With inertiafromgeom="false" a body with geoms only is massless: robodyn loads it,
     MuJoCo refuses a massless moving body."""
