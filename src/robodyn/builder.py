@@ -236,9 +236,8 @@ class ModelBuilder:
         if self.physical == "warn":
             warnings.warn(f"{message}; kept as given (physical='warn')", RobodynWarning, stacklevel=3)
             return theta
-        else:
-            raise ModelError(f"{message} (load with physical='warn' to keep it anyway, or physical='repair' to "
-                             "repair it)")
+        raise ModelError(f"{message} (load with physical='warn' to keep it anyway, or physical='repair' to "
+                         "repair it)")
 
     def add_joint(self, name: str, type: str, parent: str, child: str, xyz=(0.0, 0.0, 0.0),
                   rpy=(0.0, 0.0, 0.0), axis=(1.0, 0.0, 0.0), *, rotation=None, lower=-np.inf,
@@ -565,7 +564,8 @@ class ModelBuilder:
         return Model(
             parent=parent, joint_type=jtype, joint_axis=np.reshape(axis, (nb, 3)), joint_pitch=pitch,
             X_tree_R=X_R, X_tree_p=X_p, theta=theta, link_names=names, body_joint_names=jnames,
-            physical="error" if self.physical == "repair" else self.physical, gravity=self.gravity, lower=col["lower"], upper=col["upper"],
+            physical="error" if self.physical == "repair" else self.physical,  # repaired above
+            gravity=self.gravity, lower=col["lower"], upper=col["upper"],
             velocity_limit=col["velocity"], effort_limit=col["effort"], damping=col["damping"],
             coulomb=col["friction"], armature=col["armature"], stiffness=col["stiffness"],
             spring_reference=col["spring_reference"], frame_names=[f[0] for f in frames],
