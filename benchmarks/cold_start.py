@@ -4,10 +4,13 @@ Runs a child process with an empty Numba cache directory (``NUMBA_CACHE_DIR`` se
 temporary directory, so the caches of this installation are left alone) and times, in order:
 ``import robodyn``, the first single-state and the first batched call of ``rnea``, ``aba``,
 ``crba`` and ``coriolis_matrix``, then ``rd.warmup()`` for everything else. A second child
-process with the same cache directory then shows the cost of a later start.
+process with the same cache directory then shows the cost of a later start. The simulation
+kernels can be timed by name too: ``simulate`` (with contacts), ``rollout`` (with contacts,
+under ``JointPD``) and ``coupled_rollout`` (the same with a mimic coupling), in the order given.
 
     python benchmarks/cold_start.py            # all of it (a few minutes)
     python benchmarks/cold_start.py rnea aba   # only these algorithms, no warmup
+    python benchmarks/cold_start.py rollout    # the first contact rollout alone
 """
 
 import os
@@ -38,7 +41,23 @@ def timed(label, f):
     total += dt
     print(f"  {label:<34} {dt:8.2f} s  (total {total:7.2f} s)", flush=True)
 
+from robodyn.contact import Contacts, Plane, Sphere
+from robodyn.control import JointPD
+touch = Contacts([Sphere(i, 0.05) for i in range(model.nbodies)], surfaces=[Plane(height=10.0)])
+coupled = rd.CoupledModel(model, [(model.body_joint_names[-1], model.body_joint_names[-2], 1.0, 0.0)])
+qc = q[coupled.independent_q]
+sims = {
+    "simulate": lambda: rd.simulate(model, q, v, 0.004, 0.002, contacts=touch, progress=False),
+    "rollout": lambda: rd.rollout(model, np.stack([q, q]), v, 0.004, 0.002, JointPD(model, q, 10.0, 2.0),
+                                  contacts=touch),
+    "coupled_rollout": lambda: rd.rollout(coupled, np.stack([qc, qc]), np.zeros(coupled.nv), 0.004, 0.002,
+                                          JointPD(coupled, qc, 10.0, 2.0), contacts=touch),
+}
+
 for name in which:
+    if name in sims:
+        timed(name + " (contacts)", sims[name])
+        continue
     if name == "warmup":
         timed("rd.warmup() (everything else)", rd.warmup)
         continue

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 
 from robodyn._jit import inline, kernel
-from robodyn.algorithms.driver import batch_kernel, chunks
+from robodyn.algorithms import driver
+from robodyn.algorithms.driver import batch_kernel, chunks, threaded_batch_kernel
 
 SRC = pathlib.Path(__file__).resolve().parent.parent / "src" / "robodyn"
 
@@ -41,15 +42,17 @@ def _shifted_views(args, ws):
 
 _affine_batch = batch_kernel(_affine_at, _offset_workspace)
 _shifted_batch = batch_kernel(_affine_at, _offset_workspace, _shifted_views)
+_threaded_batch = threaded_batch_kernel(_affine_at, _offset_workspace)
 
 
+@pytest.mark.parametrize("batch", [_affine_batch, _threaded_batch], ids=["prange", "threads"])
 @pytest.mark.parametrize("B", [0, 1, 7, 1000])
-def test_every_state_computed_once_with_its_status(B):
+def test_every_state_computed_once_with_its_status(B, batch):
     rng = np.random.default_rng(B)
     X = rng.standard_normal((B, 3))
     Y = np.full((B, 3), np.nan)
     status = np.full(B, 99, dtype=np.int64)
-    _affine_batch((X, Y), (2,), status, chunks(B))
+    batch((X, Y), (2,), status, chunks(B))
     bad = X[:, 0] < 0.0
     np.testing.assert_array_equal(status, np.where(bad, -1, 0))
     np.testing.assert_array_equal(Y[~bad], 2.0 * X[~bad] + 1.0)
@@ -63,6 +66,42 @@ def test_more_chunks_than_states_and_views():
     _shifted_batch((X, Y), (3,), status, 64)
     assert (status == 0).all()
     np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+
+
+class _CountedThread(driver.threading.Thread):
+    started = 0
+
+    def start(self):
+        type(self).started += 1
+        super().start()
+
+
+@pytest.mark.parametrize("threads, nchunk, started", [(1, 8, 0), (2, 8, 1), (2, 1, 0)])
+def test_threaded_workers_one_per_thread_and_chunk(monkeypatch, threads, nchunk, started):
+    """The calling thread works too: ``min(threads, nchunk) - 1`` more; all states computed."""
+    import numba
+
+    monkeypatch.setattr(driver.threading, "Thread", _CountedThread)
+    monkeypatch.setattr(_CountedThread, "started", 0)
+    X = np.arange(40.0).reshape(20, 2)
+    Y, status = np.empty_like(X), np.full(20, 99, np.int64)
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(threads, numba.config.NUMBA_NUM_THREADS))
+    try:
+        _threaded_batch((X, Y), (2,), status, nchunk)
+    finally:
+        numba.set_num_threads(before)
+    assert _CountedThread.started == min(started, numba.config.NUMBA_NUM_THREADS - 1)
+    assert (status == 0).all()
+    np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+
+
+def test_an_exception_in_a_threaded_worker_reaches_the_caller():
+    """A workspace too large to allocate, in every worker: the caller gets Numba's error."""
+    X = np.ones((50, 2))
+    status = np.full(50, 99, np.int64)
+    with pytest.raises(ValueError, match="array is too big"):
+        _threaded_batch((X, np.empty_like(X)), (2 ** 62,), status, 4)
 
 
 KEY = """

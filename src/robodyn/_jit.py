@@ -48,7 +48,8 @@ core = njit(_nrt=False, **_CALLED)
 inline = njit(_nrt=False, **dict(_BASE, forceinline=True))
 # ``splice``: a tiny helper called with many argument types (a workspace's shapes), spliced
 # into each caller's Numba IR (``inline="always"``): cheaper to compile than one machine-code
-# function per argument type.
+# function per argument type. Also a large function with one caller (``rollout_at``): a
+# separately compiled copy would be optimised and emitted once more inside its caller.
 splice = njit(_nrt=False, inline="always", **_CALLED)
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
 # carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.

@@ -22,6 +22,9 @@ other for a while (another process, the hypervisor); with one fixed share of the
 thread, the fast thread would wait for the slow one, with claimed chunks it takes more of the
 batch. Which worker computes a state never changes its result: every state is computed alone.
 
+A batch whose one state is a whole simulation (``rollout``) uses :func:`threaded_batch_kernel`
+instead: the same workers and chunks, on Python threads (see there for why).
+
 The kernels are cached on disk like every other: Numba's own cache key of a closure pickles
 the compiled functions it closes over, which differ in every process, so it would never hit;
 :class:`ClosureCache` keys them by the source files they come from instead.
@@ -32,6 +35,7 @@ from __future__ import annotations
 import hashlib
 import os
 import sys
+import threading
 
 import numba
 import numpy as np
@@ -40,7 +44,7 @@ from numba import prange, types
 from numba.core.caching import FunctionCache
 from numba.extending import intrinsic
 
-from .._jit import core, inline, parallel
+from .._jit import core, inline, kernel, parallel
 
 CHUNKS_PER_THREAD = 32
 MIN_CHUNK = 64  # states: each worker allocates a workspace, so chunks of a small batch stay large
@@ -132,3 +136,52 @@ def batch_kernel(state_at, workspace, views=None):
                 lo, hi = claim(counter, B, nchunk)
 
     return _cached(parallel(batch))
+
+
+def threaded_batch_kernel(state_at, workspace):
+    """:func:`batch_kernel` for a heavy ``state_at`` (a whole simulation per state), its
+    workers on Python threads instead of a ``prange`` loop: ``batch(args, sizes, status,
+    nchunk)`` starts ``min(numba.get_num_threads(), nchunk) - 1`` threads and works in the
+    calling one too, each running one compiled, GIL-free worker that allocates a workspace and
+    claims chunks from the shared counter until none is left, as the workers of
+    :func:`batch_kernel` do; the results are the same. An exception in a worker (a workspace
+    that cannot be allocated) is raised in the caller once every worker has stopped.
+
+    Why: Numba optimises and emits machine code for the whole of an inlined ``state_at`` once
+    per compiled function that contains it, and a parallel loop wraps it in four (the loop
+    body, two gufunc wrappers, the kernel) where a worker is one: the first rollout compiles in
+    about half the time. For a light state (one ``rnea``) starting threads costs more than the
+    state, and the ``prange`` loop stays (``benchmarks/RESULTS.md``, cold start)."""
+
+    def work(args, sizes, status, counter, nchunk):
+        B = status.shape[0]
+        ws = workspace(*sizes)
+        lo, hi = claim(counter, B, nchunk)
+        while lo < hi:
+            for s in range(lo, hi):
+                status[s] = state_at(args, s, ws)
+            lo, hi = claim(counter, B, nchunk)
+
+    work = _cached(kernel(work))
+
+    def batch(args, sizes, status, nchunk):
+        counter, errors = np.zeros(1, np.int64), []
+
+        def worker():
+            try:
+                work(args, sizes, status, counter, nchunk)
+            except BaseException as e:  # raised in the caller below
+                errors.append(e)
+
+        threads = [threading.Thread(target=worker, daemon=True)
+                   for _ in range(min(numba.get_num_threads(), nchunk) - 1)]
+        for t in threads:
+            t.start()
+        worker()
+        for t in threads:
+            t.join()
+        if errors:
+            raise errors[0]
+
+    batch.work = work
+    return batch

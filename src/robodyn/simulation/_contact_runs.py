@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import inline, kernel
+from .._jit import inline, kernel, splice
 from ..algorithms.status import OK
 from ..contact.solver import INFO_SIZE
 from ..control.laws import law_sizes, law_torque, law_workspace
@@ -146,7 +146,7 @@ def keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
         info[k, r] = Is[j, r]
 
 
-@inline
+@splice
 def rollout_at(args, b, rws):
     """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
     ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
@@ -156,7 +156,7 @@ def rollout_at(args, b, rws):
     (ints, bodies, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, c6, c7, law, gains, breaks, coefs,
      tau_cmd, points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed, cmap, cscale,
      independent, independent_q) = args
-    c = (c0, c1, c2, c3, c4, c5, c6, c7)  # the law's model, flat in ``args`` (a parallel loop takes no nested tuple)
+    c = (c0, c1, c2, c3, c4, c5, c6, c7)  # the law's model, flat in ``args``
     body = bodies[b if bodies.shape[0] > 1 else 0]
     warm = rws[5]
     Qs, Vs, As, Ts, Fs, Ds, Is = rws[8]

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._deprecated import renamed_keyword
-from ..algorithms.driver import batch_kernel, chunks
+from ..algorithms.driver import chunks, threaded_batch_kernel
 from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
 from ..errors import RobodynWarning
@@ -32,8 +32,8 @@ from . import _contact_runs as CR
 from .coupled import run_coupling
 from .simulate import law_arrays, compiled_law, positive_number, raise_at, unit_configuration
 
-_batch = batch_kernel(CR.rollout_at, CR.rollout_workspace)
-_coupled_batch = batch_kernel(CR.rollout_at, CR.coupled_rollout_workspace)
+_batch = threaded_batch_kernel(CR.rollout_at, CR.rollout_workspace)
+_coupled_batch = threaded_batch_kernel(CR.rollout_at, CR.coupled_rollout_workspace)
 
 
 @dataclass(frozen=True)
