@@ -41,18 +41,23 @@ def timed(label, f):
     total += dt
     print(f"  {label:<34} {dt:8.2f} s  (total {total:7.2f} s)", flush=True)
 
-from robodyn.contact import Contacts, Plane, Sphere
-from robodyn.control import JointPD
-touch = Contacts([Sphere(i, 0.05) for i in range(model.nbodies)], surfaces=[Plane(height=10.0)])
-coupled = rd.CoupledModel(model, [(model.body_joint_names[-1], model.body_joint_names[-2], 1.0, 0.0)])
-qc = q[coupled.independent_q]
-sims = {
-    "simulate": lambda: rd.simulate(model, q, v, 0.004, 0.002, contacts=touch, progress=False),
-    "rollout": lambda: rd.rollout(model, np.stack([q, q]), v, 0.004, 0.002, JointPD(model, q, 10.0, 2.0),
-                                  contacts=touch),
-    "coupled_rollout": lambda: rd.rollout(coupled, np.stack([qc, qc]), np.zeros(coupled.nv), 0.004, 0.002,
-                                          JointPD(coupled, qc, 10.0, 2.0), contacts=touch),
-}
+def touching():  # every body's sphere below the plane: in contact from the start
+    from robodyn.contact import Contacts, Plane, Sphere
+    return Contacts([Sphere(i, 0.05) for i in range(model.nbodies)], surfaces=[Plane(height=10.0)])
+
+def coupled_rollout():
+    from robodyn.control import JointPD
+    coupled = rd.CoupledModel(model, [(model.body_joint_names[-1], model.body_joint_names[-2], 1.0, 0.0)])
+    qc = q[coupled.independent_q]
+    rd.rollout(coupled, np.stack([qc, qc]), np.zeros(coupled.nv), 0.004, 0.002, JointPD(coupled, qc, 10.0, 2.0),
+               contacts=touching())
+
+def rollout():
+    from robodyn.control import JointPD
+    rd.rollout(model, np.stack([q, q]), v, 0.004, 0.002, JointPD(model, q, 10.0, 2.0), contacts=touching())
+
+sims = {"simulate": lambda: rd.simulate(model, q, v, 0.004, 0.002, contacts=touching(), progress=False),
+        "rollout": rollout, "coupled_rollout": coupled_rollout}
 
 for name in which:
     if name in sims:
