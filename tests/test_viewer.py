@@ -306,10 +306,39 @@ def test_render_video_gif_has_one_frame_per_period(tmp_path):
     np.testing.assert_array_equal(frame_samples(np.array([0.0, 0.5]), 4), [0, 0, 1])
 
 
+def test_render_video_mp4_has_the_frames_of_the_gif(tmp_path):
+    """The MP4 (the system's ffmpeg or imageio-ffmpeg's, a test dependency) decodes to the
+    GIF's frame count, size and rate, each frame the GIF's picture of the same time (up to the
+    video's lossy coding)."""
+    import imageio_ffmpeg
+
+    model = rd.models.load("double_pendulum")
+    t = np.linspace(0.0, 1.0, 101)
+    log = tmp_path / "swing.csv"
+    write_log(log, model, t, np.column_stack([np.sin(3 * t), np.cos(2 * t)]))
+    n = rd.viewer.render_video(model, log, tmp_path / "swing.mp4", fps=8, size=(160, 120))
+    assert n == rd.viewer.render_video(model, log, tmp_path / "swing.gif", fps=8, size=(160, 120)) == 9
+    reader = imageio_ffmpeg.read_frames(str(tmp_path / "swing.mp4"))
+    meta = next(reader)
+    assert tuple(meta["size"]) == (160, 120) and meta["fps"] == 8
+    frames = [np.frombuffer(f, np.uint8).reshape(120, 160, 3).astype(int) for f in reader]
+    assert len(frames) == 9
+    pictures = []
+    with Image.open(tmp_path / "swing.gif") as gif:
+        for j in range(9):
+            gif.seek(j)
+            pictures.append(np.asarray(gif.convert("RGB"), dtype=int))
+    assert (np.abs(pictures[0] - pictures[8]).sum(-1) > 30).mean() > 0.005  # the pendulum moved
+    for j, frame in enumerate(frames):  # each frame the GIF's picture of the same time, no other
+        distance = [np.abs(frame - p).mean() for p in pictures]
+        assert np.argmin(distance) == j and distance[j] < 3, (j, distance)
+
+
 def test_mp4_without_ffmpeg_is_a_clear_error_before_any_work(tmp_path, monkeypatch):
     from matplotlib.animation import FFMpegWriter
 
     monkeypatch.setattr(FFMpegWriter, "isAvailable", classmethod(lambda cls: False))
+    monkeypatch.setitem(sys.modules, "imageio_ffmpeg", None)  # neither ffmpeg: import fails
     model = rd.models.load("pendulum")
     with pytest.raises(ValueError, match="ffmpeg"):
         rd.viewer.render_video(model, "never-read.csv", tmp_path / "x.mp4")

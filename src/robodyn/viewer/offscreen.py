@@ -156,8 +156,8 @@ def frame_samples(t: np.ndarray, fps: float) -> np.ndarray:
 
 def render_video(model, trajectory, path, *, fps: float = 25, camera=None, size=(640, 480), visuals=None,
                  contacts=None, max_faces: int = 8000) -> int:
-    """Write a GIF (``.gif``, by Pillow) or an MP4 (``.mp4``, by ffmpeg, which must be
-    installed) of a trajectory, in real time at ``fps`` frames per second (see
+    """Write a GIF (``.gif``, by Pillow) or an MP4 (``.mp4``, by ffmpeg: the system's, or the
+    one of ``pip install robodyn[video]``) of a trajectory, in real time at ``fps`` frames per second (see
     :func:`frame_samples`), with the time in a corner and, for a simulation with contacts,
     the contact forces as red segments (the robot's weight half its size, none longer than
     it; ``contacts``: see
@@ -171,12 +171,7 @@ def render_video(model, trajectory, path, *, fps: float = 25, camera=None, size=
     suffix = Path(path).suffix.lower()
     if suffix not in (".gif", ".mp4"):
         raise ValueError(f"{path}: expected a .gif or .mp4 file name")
-    if suffix == ".mp4":
-        from matplotlib.animation import FFMpegWriter
-
-        if not FFMpegWriter.isAvailable():
-            raise ValueError(f"{path}: writing MP4 needs ffmpeg, which is not installed "
-                             "(apt-get install ffmpeg), or write a .gif")
+    ffmpeg = _ffmpeg(path) if suffix == ".mp4" else None
     if not (isinstance(fps, (int, float)) and math.isfinite(fps) and fps > 0):
         raise ValueError(f"fps: expected a positive number of frames per second, got {fps!r}")
     w, h = _size(size)
@@ -194,9 +189,31 @@ def render_video(model, trajectory, path, *, fps: float = 25, camera=None, size=
             frames[0].save(tmp, format="GIF", save_all=True, append_images=frames[1:],
                            duration=max(10, round(1000 / fps)), loop=0)
         else:
-            writer = FFMpegWriter(fps=fps)
-            with writer.saving(painter.fig, str(tmp), dpi=100):
-                for j, k in enumerate(samples):
-                    painter.draw(k, play.t[0] + j / fps)
-                    writer.grab_frame()
+            import matplotlib
+            from matplotlib.animation import FFMpegWriter
+
+            with matplotlib.rc_context({"animation.ffmpeg_path": ffmpeg}):
+                writer = FFMpegWriter(fps=fps)
+                with writer.saving(painter.fig, str(tmp), dpi=100):
+                    for j, k in enumerate(samples):
+                        painter.draw(k, play.t[0] + j / fps)
+                        writer.grab_frame()
     return len(samples)
+
+
+def _ffmpeg(path) -> str:
+    """The ffmpeg program that writes ``path``: matplotlib's (``animation.ffmpeg_path``, the
+    one on the ``PATH`` by default), else the one the ``imageio-ffmpeg`` package ships
+    (``pip install robodyn[video]``); a ``ValueError`` when there is neither."""
+    import matplotlib
+    from matplotlib.animation import FFMpegWriter
+
+    if FFMpegWriter.isAvailable():
+        return matplotlib.rcParams["animation.ffmpeg_path"]
+    try:
+        import imageio_ffmpeg
+
+        return imageio_ffmpeg.get_ffmpeg_exe()
+    except (ImportError, RuntimeError):
+        raise ValueError(f"{path}: writing MP4 needs ffmpeg, which is not installed (pip install "
+                         "'robodyn[video]', or apt-get install ffmpeg), or write a .gif") from None
