@@ -112,6 +112,23 @@ def test_batch_matches_single_states(model):
         assert res.rank[i] == one.rank
 
 
+@pytest.mark.parametrize("model", TREES, ids=TREE_IDS)
+def test_unchecked_nan_propagates_to_its_own_state(model):
+    """``check_finite=False``: a state with NaN gets NaN (a NaN configuration rank 0), not an
+    error from the Schur complement's eigensolver, and the other states their own results."""
+    rng = rng_for(model.name, "nan")
+    q, v, tau = rd.random.random_state(model, rng, (4,))
+    cons = _constraints(model, q[0])
+    q[1, -1], tau[2, 0] = np.nan, np.nan
+    res = rd.constrained_dynamics(model, q, v, tau, cons, check_finite=False)
+    for i in (1, 2):
+        assert np.isnan(res.a[i]).all() and all(np.isnan(f[i]).all() for f in res.forces)
+    assert res.rank[1] == 0 and res.rank[2] == rd.constrained_dynamics(model, q[2], v[2], np.zeros(model.nv), cons).rank
+    for i in (0, 3):
+        one = rd.constrained_dynamics(model, q[i], v[i], tau[i], cons)
+        assert_rel(res.a[i], one.a, 1e-12)
+        assert res.rank[i] == one.rank
+
 # -- the pendulum: a point mass on two prismatic joints held by a rod -------------------------
 M_BOB, L_ROD = 2.0, 0.7
 

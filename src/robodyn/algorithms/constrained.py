@@ -355,7 +355,13 @@ def cholesky(M: np.ndarray, what: str) -> np.ndarray:
 
 def symmetric_pinv(S: np.ndarray, rcond: float) -> tuple[np.ndarray, np.ndarray]:
     """Pseudo-inverses (B, m, m) of symmetric positive semi-definite matrices and their ranks
-    (B,): eigenvalues at most ``rcond`` times the largest count as zero."""
+    (B,): eigenvalues at most ``rcond`` times the largest count as zero. A matrix with NaN or
+    Inf (inputs that ``check_finite=False`` let through) gives NaN and rank 0."""
+    finite = np.isfinite(S).all(axis=(1, 2))
+    if not finite.all():
+        P, rank = np.full_like(S, np.nan), np.zeros(S.shape[0], dtype=np.int64)
+        P[finite], rank[finite] = symmetric_pinv(S[finite], rcond)
+        return P, rank
     w, V = np.linalg.eigh(S)
     if w.shape[-1] == 0:
         return S.copy(), np.zeros(S.shape[0], dtype=np.int64)
@@ -386,7 +392,8 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
 
     Returns:
         :class:`ConstrainedDynamics` ``(a, forces, rank)``. Without constraints ``a`` equals
-        ``aba(q, v, tau)``.
+        ``aba(q, v, tau)``. With ``check_finite=False`` a state with NaN or Inf gets NaN
+        (rank 0), the others their own results.
 
     Raises ValueError for bad shapes or values, unknown bodies or joints, and a mass matrix
     that is not positive definite. Reference: Featherstone, RBDA (2008), chapter 8;
