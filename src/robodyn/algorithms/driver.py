@@ -183,5 +183,4 @@ def threaded_batch_kernel(state_at, workspace):
         if errors:
             raise errors[0]
 
-    batch.work = work
     return batch

@@ -157,8 +157,8 @@ def frame_samples(t: np.ndarray, fps: float) -> np.ndarray:
 def render_video(model, trajectory, path, *, fps: float = 25, camera=None, size=(640, 480), visuals=None,
                  contacts=None, max_faces: int = 8000) -> int:
     """Write a GIF (``.gif``, by Pillow) or an MP4 (``.mp4``, by ffmpeg: the system's, or the
-    one of ``pip install robodyn[video]``) of a trajectory, in real time at ``fps`` frames per second (see
-    :func:`frame_samples`), with the time in a corner and, for a simulation with contacts,
+    one of ``pip install robodyn[video]``) of a trajectory, in real time at ``fps`` frames per
+    second (see :func:`frame_samples`), with the time in a corner and, for a simulation with contacts,
     the contact forces as red segments (the robot's weight half its size, none longer than
     it; ``contacts``: see
     :func:`robodyn.viewer.scene.playback`). ``trajectory``: a :class:`robodyn.Trajectory`
