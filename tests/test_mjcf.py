@@ -568,3 +568,116 @@ def test_mutated_models_load_or_raise_model_error(rel):
         except rd.ModelError:
             outcomes.add("error")
     assert "error" in outcomes
+
+
+# -- the geoms the viewer draws (robodyn.viewer.mjcf_visuals) -------------------------------------
+_DRAWN = {2: "sphere", 3: "capsule", 5: "cylinder", 6: "box", 7: "mesh"}  # mjtGeom -> VisualShape kind
+# MuJoCo's geom quaternions given in a default class differ from the file's (normalised) by up to 3e-7
+_CLASS_QUATERNIONS = {"dm_control/mjcf/test_assets/robot_arm.xml", "dm_control/mujoco/testing/assets/arm.xml"}
+
+
+@pytest.mark.parametrize("rel", sorted(set(CORPUS) - set(REFUSED) - set(BOTH_REFUSE) - set(MUJOCO_REFUSES)))
+def test_drawn_geoms_are_mujocos(rel):
+    """Every geom MuJoCo shows by default (groups 0-2, not a plane) is drawn, in MuJoCo's
+    order, with its world pose at a random state (a mesh: its vertices in the world), size
+    and colour."""
+    _assert_drawn_as_mujoco(CORPUS[rel], zlib.crc32(rel.encode()), 1e-6 if rel in _CLASS_QUATERNIONS else 1e-9)
+
+
+def _assert_drawn_as_mujoco(path, seed: int, turn: float = 1e-9):
+    from scipy.spatial import cKDTree
+
+    from robodyn.io.mjcf import read_mjcf_visuals
+    from robodyn.viewer.geometry import mjcf_visuals, shape_mesh, visual_poses
+
+    mm, model = mujoco.MjModel.from_xml_path(str(path)), _load_quietly(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rd.RobodynWarning)
+        geoms, shapes = read_mjcf_visuals(path), mjcf_visuals(path, model)
+    expected = [i for i in range(mm.ngeom) if mm.geom_group[i] <= 2 and int(mm.geom_type[i]) in _DRAWN]
+    assert [g.index for g in geoms] == expected and [s.name for s in shapes] == [g.name for g in geoms]
+    d = mujoco.MjData(mm)
+    d.qpos[:] = _random_qpos(mm, np.random.default_rng(seed))
+    mujoco.mj_kinematics(mm, d)
+    poses = visual_poses(model, shapes, rd.interop.mujoco.qpos_to_q(model, d.qpos))
+    for g, s, T in zip(geoms, shapes, poses):
+        i, R = g.index, d.geom_xmat[g.index].reshape(3, 3)
+        assert s.kind == _DRAWN[int(mm.geom_type[i])]
+        if g.rgba is not None and mm.geom_matid[i] < 0:
+            np.testing.assert_allclose(g.rgba, mm.geom_rgba[i], rtol=1e-7)
+        if s.kind == "mesh":  # MuJoCo moves a mesh's vertices to its inertia frame, and the geom frame with them
+            k = mm.geom_dataid[i]
+            theirs = mm.mesh_vert[mm.mesh_vertadr[k]:mm.mesh_vertadr[k] + mm.mesh_vertnum[k]] @ R.T + d.geom_xpos[i]
+            ours = shape_mesh(s).vertices @ T[:3, :3].T + T[:3, 3]
+            scale = np.ptp(theirs, axis=0).max()
+            assert cKDTree(ours).query(theirs)[0].max() < 1e-6 * scale, g.name
+            assert cKDTree(theirs).query(ours)[0].max() < 1e-6 * scale, g.name
+            continue
+        size = mm.geom_size[i]
+        np.testing.assert_allclose(s.size, {"sphere": size[:1], "capsule": [size[0], 2 * size[1]],
+                                            "cylinder": [size[0], 2 * size[1]], "box": 2 * size}[s.kind], rtol=1e-12)
+        np.testing.assert_allclose(T[:3, 3], d.geom_xpos[i], rtol=0, atol=1e-9 * max(1.0, np.abs(d.geom_xpos[i]).max()))
+        if s.kind != "sphere":
+            np.testing.assert_allclose(T[:3, :3], R, rtol=0, atol=turn)
+
+
+
+SCENE = """<mujoco model="scene">
+  <compiler meshdir="shapes" angle="radian"/>
+  <asset>
+    <mesh name="wedge" file="wedge.obj" scale="2 1 0.5"/>
+    <mesh file="block.obj"/>
+    <material name="steel" rgba="0.3 0.4 0.5 1"/>
+  </asset>
+  <default>
+    <default class="collision"><geom group="3" rgba="1 0 0 1"/></default>
+    <default class="visual"><geom group="2" material="steel" contype="0" conaffinity="0"/></default>
+  </default>
+  <worldbody>
+    <geom type="plane" size="2 2 0.1"/>
+    <geom name="post" type="box" size="0.1 0.2 0.3" pos="1 0 0.3" euler="0.1 0.2 0.3"/>
+    <body name="arm" pos="0 0 1">
+      <joint type="hinge" axis="0 1 0"/>
+      <inertial pos="0.25 0 0" mass="1" diaginertia="0.01 0.02 0.025"/>
+      <geom class="collision" type="capsule" fromto="0 0 0 0.5 0 0" size="0.05"/>
+      <geom class="visual" type="mesh" mesh="wedge" pos="0.2 0 0" quat="0.9 0.1 0.3 0.2"/>
+      <geom type="ellipsoid" size="0.1 0.2 0.3"/>
+      <frame pos="0.5 0 0" euler="0 0.5 0">
+        <geom name="tip" type="box" fromto="0 0 0 0 0 0.2" size="0.03" rgba="0 1 0 1"/>
+        <geom type="mesh" mesh="block"/>
+      </frame>
+      <body name="hand" pos="0.5 0 0">
+        <joint type="slide" axis="1 0 0"/>
+        <geom type="cylinder" size="0.04 0.1" zaxis="1 1 0" mass="0.2"/>
+      </body>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+WEDGE = "v 0 0 0\nv 0.3 0 0\nv 0 0.2 0\nv 0.05 0.05 0.4\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n"
+
+
+def test_drawn_geoms_of_a_scene_with_classes_frames_and_scaled_meshes(tmp_path):
+    """Groups from default classes (the collision class hidden), a material's colour, a mesh
+    scaled and found in ``meshdir`` (and one named after its file), a ``fromto`` box in a
+    ``<frame>``, world geoms: as MuJoCo places them; the plane left out silently, the
+    ellipsoid with a warning."""
+    from robodyn.io.mjcf import read_mjcf_visuals
+
+    (tmp_path / "shapes").mkdir()
+    for name in ("wedge", "block"):
+        (tmp_path / "shapes" / f"{name}.obj").write_text(WEDGE)
+    path = tmp_path / "scene.xml"
+    path.write_text(SCENE)
+    with pytest.warns(rd.RobodynWarning, match=r"geoms not drawn: .*<geom> \(line 20\): type 'ellipsoid'") as caught:
+        geoms = read_mjcf_visuals(path)
+    assert len(caught) == 1 and "plane" not in str(caught[0].message)
+    assert [(g.link, g.name, g.kind) for g in geoms] == [
+        ("world", "post", "box"), ("arm", "arm_0", "mesh"), ("arm", "tip", "box"), ("arm", "arm_2", "mesh"),
+        ("hand", "hand_0", "cylinder")]
+    np.testing.assert_array_equal(geoms[1].rgba, [0.3, 0.4, 0.5, 1])
+    np.testing.assert_array_equal(geoms[1].scale, [2, 1, 0.5])
+    np.testing.assert_array_equal(geoms[3].scale, [1, 1, 1])
+    assert geoms[1].filename == str(tmp_path / "shapes" / "wedge.obj")
+    _assert_drawn_as_mujoco(path, 7)

@@ -8,6 +8,7 @@ from __future__ import annotations
 import subprocess
 import sys
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -439,3 +440,59 @@ def test_cli_view_of_an_example_robot_by_name(tmp_path, capsys):
     assert Image.open(gif).n_frames == 5
     assert main(["view", "solo13"]) == 2
     assert "example-robot-data" in capsys.readouterr().err
+
+
+def test_cli_view_of_an_mjcf_file_draws_its_geoms(tmp_path, monkeypatch):
+    """``robodyn view ant.xml``: the geoms of the file (gymnasium's ant: capsules and a sphere
+    of rgba 0.8 0.6 0.4), not the capsule skeleton, in the render and in the browser."""
+    import gymnasium
+
+    from robodyn.viewer import mjcf_visuals
+
+    path = Path(gymnasium.__file__).parent / "envs/mujoco/assets/ant.xml"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RobodynWarning)
+        model = rd.load_mjcf(path)
+        expected = mjcf_visuals(path, model)
+        png = tmp_path / "ant.png"
+        assert main(["view", str(path), "--png", str(png)]) == 0
+        seen = {}
+        monkeypatch.setattr(rd.viewer, "show", lambda model, **kw: seen.update(kw))
+        assert main(["view", str(path), "--port", "0"]) == 0
+    assert [v.name for v in seen["visuals"]] == [v.name for v in expected] and len(expected) == 13
+    assert {v.kind for v in expected} == {"sphere", "capsule"}
+    image = pixels(png)
+    tan = np.abs(image - np.array([0.8, 0.6, 0.4]) * 255).max(axis=2) < 30  # the file's colour, shaded
+    assert tan.mean() > 0.01  # the skeleton (grey-blue, orange joints) has 0.03 % such pixels
+
+
+def _msh(vertices, faces, normals=0, texcoords=0) -> bytes:
+    v, f = np.asarray(vertices, "<f4"), np.asarray(faces, "<i4")
+    head = np.array([len(v), normals, texcoords, len(f)], "<i4")
+    return head.tobytes() + v.tobytes() + np.zeros(3 * normals + 2 * texcoords, "<f4").tobytes() + f.tobytes()
+
+
+def test_mujoco_msh_meshes_are_read_and_bad_ones_refused(tmp_path):
+    """MuJoCo's binary ``.msh``: the vertices and faces it holds (after its normals and texture
+    coordinates); a size that does not match the header, an index out of range or no faces is
+    a ValueError naming the fault (a drawn shape: a warning, not drawn)."""
+    from robodyn.viewer.geometry import load_msh
+
+    V = [[0, 0, 0], [1, 0, 0], [0, 2, 0], [0, 0, 3]]
+    F = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]
+    good = tmp_path / "tet.msh"
+    good.write_bytes(_msh(V, F, normals=4, texcoords=4))
+    mesh = load_mesh_file(good)
+    np.testing.assert_array_equal(mesh.vertices, V)
+    np.testing.assert_array_equal(mesh.faces, F)
+    assert mesh.colors.shape == (4, 4)
+    for data, message in ((good.read_bytes()[:-4], "do not hold"), (b"\x01\x00", "16-byte header"),
+                          (_msh(V, [[0, 1, 4]]), "outside the 4 vertices"), (_msh(V, np.zeros((0, 3))), "no triangles"),
+                          (np.array([-1, 0, 0, 0], "<i4").tobytes(), "do not hold")):
+        bad = tmp_path / "bad.msh"
+        bad.write_bytes(data)
+        with pytest.raises(ValueError, match=message):
+            load_msh(bad)
+    shape = VisualShape("m", "world", -1, np.eye(4), "mesh", (), bad, np.ones(3), None)
+    with pytest.warns(RobodynWarning, match="bad.msh .*cannot be read"):
+        assert shape_mesh(shape) is None

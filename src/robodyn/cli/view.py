@@ -5,7 +5,8 @@ PNG or a GIF/MP4 without a browser (:func:`robodyn.viewer.render`, ``render_vide
     robodyn view MODEL --png robot.png           # one picture, no server
     robodyn view MODEL --trajectory run.csv --video run.gif
 
-A URDF model is drawn with its ``<visual>`` geometry, any other as its capsule skeleton.
+A URDF model is drawn with its ``<visual>`` geometry, an MJCF model with its geoms, a built-in
+robot as its capsule skeleton.
 """
 
 from __future__ import annotations
@@ -39,12 +40,11 @@ def cmd_view(args) -> int:
     if args.video and not str(args.video).lower().endswith((".gif", ".mp4")):
         raise ValueError(f"--video {args.video}: expected a .gif or .mp4 file name")
     model = loaded(args)
-    urdf = args.model not in models.names() and not args.model.lower().endswith((".xml", ".mjcf"))
     visuals = None
-    if urdf:
+    if args.model not in models.names():  # a URDF's visuals or an MJCF file's geoms
         from ..viewer import visuals as read_visuals
 
-        named = not (args.model.endswith(".urdf") or "/" in args.model)
+        named = not (args.model.lower().endswith((".urdf", ".xml", ".mjcf")) or "/" in args.model)
         source = models.example_robot_urdf(args.model) if named else args.model
         visuals = read_visuals(source, model, package_dirs=args.package_dir)
         if any(v.kind == "mesh" for v in visuals):

@@ -42,7 +42,8 @@ equalities, a joint locked by an equality without ``joint2``), sensors, contact 
 limits of ball joints (``range``: a bound on the rotation angle, which robodyn's box limits on
 dofs cannot hold) and gravity compensation (``gravcomp``). Springs of hinge and slide joints (``stiffness``,
 ``springref``) are the model's ``stiffness`` and ``spring_reference``. Visual elements (assets, cameras, lights) are skipped
-silently. Contacts are not part of the model.
+silently. Contacts are not part of the model. The geoms to draw, on the same bodies:
+:func:`read_mjcf_visuals` (what ``robodyn.viewer`` draws of an MJCF file).
 
 The XML is read as the URDF loader reads it: DTDs, entities and external references
 forbidden, size and depth bounded, at most ``MAX_INCLUDES`` included files.
@@ -54,6 +55,7 @@ import warnings
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 
@@ -64,7 +66,7 @@ from ..lie import exp_so3, quat_matrix
 from ..model import Model
 from ._xml import is_xml_text, parse, read_source
 
-__all__ = ["MAX_FILE_BYTES", "MAX_INCLUDES", "load_mjcf"]
+__all__ = ["MAX_FILE_BYTES", "MAX_INCLUDES", "GeomVisual", "load_mjcf", "read_mjcf_visuals"]
 
 MAX_FILE_BYTES = 64 * 1024 * 1024
 MAX_INCLUDES = 100
@@ -149,24 +151,12 @@ def load_mjcf(source, *, physical: str = "error", mimic: str = "couple") -> Mode
     is a degree of freedom (the equalities are ignored, with a warning naming them)."""
     if mimic not in ("couple", "independent"):
         raise ValueError(f"mimic must be 'couple' or 'independent', got {mimic!r}")
-    text, name = read_source(source, "MJCF", MAX_FILE_BYTES)
-    root, lines = parse(text, name)
-    doc = _Doc(name, lines)
-    if root.tag != "mujoco":
-        raise ModelError(f"{doc.where(root)}: root element must be <mujoco>, got <{root.tag}>")
-    base = None if is_xml_text(source) or isinstance(source, bytes) else Path(name).parent
-    _expand_includes(root, doc, base, [name])
-    compiler = _read_compiler(root, doc)
-    gravity = _read_gravity(root, doc)
-    defaults = _read_defaults(root, doc)
-    ignored: Counter[str] = Counter()
+    root, doc, reader = _read_tree(source)
+    name, ignored = doc.name, reader.ignored
     for elem in root:
         if isinstance(elem.tag, str) and elem.tag not in _TOP_READ | _TOP_SILENT:
             ignored[elem.tag] += 1
-    reader = _Bodies(doc, compiler, defaults, ignored)
-    for world in root.findall("worldbody"):
-        reader.children(world, "world", (np.eye(3), np.zeros(3)), "main", world=True)
-    b = ModelBuilder(root.get("model", "mujoco"), gravity=gravity, source=name, physical=physical)
+    b = ModelBuilder(root.get("model", "mujoco"), gravity=_read_gravity(root, doc), source=name, physical=physical)
     reader.build(b)
     couplings = _joint_equalities(root, doc, reader, ignored)
     notes = []
@@ -183,6 +173,137 @@ def load_mjcf(source, *, physical: str = "error", mimic: str = "couple") -> Mode
         warnings.warn(f"{name}: " + "; ".join(notes), RobodynWarning, stacklevel=2)
     model = b.build()
     return CoupledModel(model, couplings) if couplings and mimic == "couple" else model
+
+
+def _read_tree(source, visuals: bool = False):
+    """``(root, doc, reader)``: the parsed file (includes expanded) and its body tree read;
+    with ``visuals`` the reader also collects the drawable geoms (:func:`read_mjcf_visuals`)."""
+    text, name = read_source(source, "MJCF", MAX_FILE_BYTES)
+    root, lines = parse(text, name)
+    doc = _Doc(name, lines)
+    if root.tag != "mujoco":
+        raise ModelError(f"{doc.where(root)}: root element must be <mujoco>, got <{root.tag}>")
+    base = None if is_xml_text(source) or isinstance(source, bytes) else Path(name).parent
+    _expand_includes(root, doc, base, [name])
+    reader = _Bodies(doc, _read_compiler(root, doc), _read_defaults(root, doc), Counter())
+    if visuals:
+        reader.visuals = _Visuals(root, doc, reader, Path.cwd() if base is None else base)
+    worlds = root.findall("worldbody")
+    for world in worlds if visuals else ():  # the world's geoms come first in MuJoCo's order
+        reader.visuals.collect(world, "world", (np.eye(3), np.zeros(3)), "main")
+    for world in worlds:
+        reader.children(world, "world", (np.eye(3), np.zeros(3)), "main", world=True)
+    return root, doc, reader
+
+
+class GeomVisual(NamedTuple):
+    """One drawable ``<geom>`` of an MJCF file: ``link`` the body it belongs to (``"world"``
+    for the ``<worldbody>``'s own), ``index`` its geom number in MuJoCo's model (``mjModel``'s
+    geom id: every geom in body order), ``name`` its name or ``<link>_<k>``, ``kind`` one of
+    ``sphere``, ``capsule``, ``cylinder``, ``box``, ``mesh``, ``size`` as the viewer takes
+    it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its sphere centres;
+    a box's three edges; ``()`` for a mesh), ``filename`` the mesh file (None for the
+    others), ``R`` (3, 3), ``p`` (3,) the geom frame in the link frame, ``scale`` (3,) the
+    mesh's, ``rgba`` (4,) or None (the file gives no colour), ``where`` file and line."""
+    link: str
+    index: int
+    name: str
+    kind: str
+    size: tuple
+    filename: str | None
+    R: np.ndarray
+    p: np.ndarray
+    scale: np.ndarray
+    rgba: np.ndarray | None
+    where: str
+
+
+def read_mjcf_visuals(source) -> list[GeomVisual]:
+    """The geoms MuJoCo draws by default (``group`` 0, 1 or 2) of an MJCF file (path) or XML
+    string, on the bodies :func:`load_mjcf` reads, in MuJoCo's geom order (planes, the ground,
+    left out). Mesh files come
+    from ``<asset><mesh file scale>`` in ``<compiler meshdir>`` (or ``assetdir``), relative
+    to the file's folder; colours from the geom's ``rgba`` (its class's) or its
+    ``<material rgba>``. Height fields, ellipsoids and SDFs are not drawn; they and a
+    geom that cannot be drawn (a mesh without a file, an unknown mesh) are left out with one
+    :class:`RobodynWarning` naming them. Errors of the body tree are the loader's."""
+    _, doc, reader = _read_tree(source, visuals=True)
+    v = reader.visuals
+    if v.skipped:
+        warnings.warn(f"{doc.name}: geoms not drawn: " + "; ".join(v.skipped), RobodynWarning, stacklevel=2)
+    return v.out
+
+
+class _Visuals:
+    """Collects a body's drawable geoms while :class:`_Bodies` walks the tree."""
+
+    DEFAULT_GROUPS = (0, 1, 2)  # the groups MuJoCo's viewer shows at start
+
+    def __init__(self, root, doc: _Doc, reader, base: Path):
+        self.doc, self.reader, self.out, self.skipped, self.count = doc, reader, [], [], 0
+        c = {}
+        for e in root.findall("compiler"):
+            c.update(e.attrib)
+        mesh_dir = base / c.get("meshdir", c.get("assetdir", ""))
+        self.meshes, self.materials = {}, {}
+        for asset in root.findall("asset"):
+            for m in asset.findall("mesh"):
+                a = reader.attrs(m, "main")
+                if "file" not in a:
+                    continue  # vertices in the file itself: not read
+                file = Path(a["file"])
+                key = m.get("name") or file.stem
+                self.meshes[key] = (mesh_dir / file, doc.floats(m, a, "scale", 3, (1.0, 1.0, 1.0)))
+            for m in asset.findall("material"):
+                if m.get("name") and "rgba" in m.attrib:
+                    self.materials[m.get("name")] = doc.floats(m, m.attrib, "rgba", 4)
+
+    def collect(self, elem, link: str, pre, cls: str) -> None:
+        """The geoms of body (or frame) ``elem`` whose frame sits at ``pre`` in ``link``'s."""
+        for g in elem:
+            if g.tag == "frame":
+                a = self.reader.attrs(g, cls)
+                self.collect(g, link, _compose(pre, self.reader.pose(g, a)), g.get("childclass", cls))
+            elif g.tag == "geom":
+                index, self.count = self.count, self.count + 1
+                try:
+                    self.geom(g, self.reader.attrs(g, cls), link, pre, index)
+                except ModelError as e:
+                    self.skipped.append(str(e))
+
+    def geom(self, g, a, link: str, pre, index: int) -> None:
+        doc = self.doc
+        kind = a.get("type", "sphere")
+        if int(doc.number(g, a, "group", 0)) not in self.DEFAULT_GROUPS:
+            return
+        if kind == "plane":
+            return  # the ground: a viewer draws its own
+        if kind not in ("sphere", "capsule", "cylinder", "box", "mesh"):
+            raise ModelError(f"{doc.where(g)}: type {kind!r}")
+        size = np.zeros(3)
+        if kind != "mesh":
+            given = doc.floats(g, a, "size", (1, 3), (0.0,))
+            size[: given.size] = given
+        if "fromto" in a and kind != "mesh":
+            pose, half = self.reader.fromto(g, a)
+            size[1:] = (size[0], half) if kind == "box" else (half, 0.0)
+        else:
+            pose = self.reader.pose(g, a)
+        filename, scale = None, np.ones(3)
+        if kind == "mesh":
+            if a.get("mesh") not in self.meshes:
+                raise ModelError(f"{doc.where(g)}: mesh {a.get('mesh')!r} is not an <asset> mesh with a file")
+            path, scale = self.meshes[a["mesh"]]
+            filename = str(path)
+        shape = {"sphere": (size[0],), "capsule": (size[0], 2 * size[1]), "cylinder": (size[0], 2 * size[1]),
+                 "box": tuple(2 * size), "mesh": ()}[kind]
+        if any(not x > 0 for x in shape):
+            raise ModelError(f"{doc.where(g)}: size {shape} is not positive")
+        rgba = doc.floats(g, a, "rgba", 4) if "rgba" in a else self.materials.get(a.get("material"))
+        R, p = _compose(pre, pose)
+        k = sum(v.link == link for v in self.out)
+        self.out.append(GeomVisual(link, index, g.get("name") or f"{link}_{k}", kind, shape, filename, R, p,
+                                   np.asarray(scale, dtype=float), rgba, doc.where(g)))
 
 
 def _joint_equalities(root, doc: _Doc, reader: _Bodies, ignored: Counter) -> list[tuple]:
@@ -376,6 +497,7 @@ class _Bodies:
         self.nbody = 0
         self.njoint = 0
         self.named: dict[str, tuple[str, float]] = {}  # joint named in the file -> (MJCF type, ref in q units)
+        self.visuals = None  # a _Visuals when the drawable geoms are read too
 
     # attributes with defaults -----------------------------------------------------------
     def attrs(self, elem, cls: str, tag: str | None = None) -> dict:
@@ -532,6 +654,8 @@ class _Bodies:
                                 doc.where(elem)))
             link, frame = name, (np.eye(3), np.zeros(3))
         self.inertia(elem, cls, self.links[-1], frame, any(t == "free" for t in types))
+        if self.visuals is not None:
+            self.visuals.collect(elem, link, frame, cls)
         self.children(elem, link, frame, cls, world and not joints)
 
     def limited(self, elem, a) -> bool:

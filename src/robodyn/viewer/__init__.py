@@ -10,8 +10,9 @@
 
 The model keeps no geometry: ``visuals=`` names the URDF it was loaded from (its
 ``<visual>`` elements: meshes STL/OBJ/DAE by trimesh, ``package://`` and relative paths
-resolved, boxes, cylinders, spheres, ``<material>`` colours), or gives the records of
-:func:`visuals`. Without visuals a robot is drawn as its capsule skeleton (:func:`skeleton`).
+resolved, boxes, cylinders, spheres, ``<material>`` colours) or the MJCF file (its geoms,
+:func:`mjcf_visuals`), or gives the records of :func:`visuals`. Without visuals a robot is
+drawn as its capsule skeleton (:func:`skeleton`).
 
 :func:`show` (browser, viser) needs the optional extra, ``pip install "robodyn[viewer]"``
 (viser, trimesh, pycollada for DAE meshes); :func:`render` and :func:`render_video` need
@@ -19,10 +20,10 @@ only matplotlib, and trimesh for meshes. The command line: ``robodyn view MODEL`
 """
 
 from .camera import Camera
-from .geometry import Mesh, VisualShape, resolve_mesh, shape_mesh, skeleton, visual_poses, visuals
+from .geometry import Mesh, VisualShape, mjcf_visuals, resolve_mesh, shape_mesh, skeleton, visual_poses, visuals
 from .offscreen import render, render_video
 from .scene import Part, Playback, parts, playback
 from .server import Viewer, show
 
-__all__ = ["show", "render", "render_video", "visuals", "visual_poses", "skeleton", "VisualShape", "Camera",
+__all__ = ["show", "render", "render_video", "visuals", "mjcf_visuals", "visual_poses", "skeleton", "VisualShape", "Camera",
            "Viewer", "Mesh", "Part", "Playback", "parts", "playback", "resolve_mesh", "shape_mesh"]

@@ -20,6 +20,7 @@ from __future__ import annotations
 import importlib
 import math
 import os
+import re
 import warnings
 from pathlib import Path
 from typing import NamedTuple
@@ -76,7 +77,8 @@ def homogeneous(R, p) -> np.ndarray:
 
 
 def visuals(source, model=None, *, floating_base: bool = False, package_dirs=()) -> list[VisualShape]:
-    """The visual geometry of a URDF file (path) or XML string, on the bodies of ``model``.
+    """The visual geometry of a URDF file (path) or XML string, on the bodies of ``model``
+    (an MJCF file or string: its geoms, :func:`mjcf_visuals`).
 
     ``model``: the model loaded from the same source (default: ``load_urdf(source,
     floating_base)``); every link is mapped to the body a fixed joint merged it into with its
@@ -88,6 +90,8 @@ def visuals(source, model=None, *, floating_base: bool = False, package_dirs=())
     """
     from ..io.urdf import load_urdf, read_visuals
 
+    if is_mjcf(source):
+        return mjcf_visuals(source, model)
     if model is None:
         with warnings.catch_warnings():  # what the loader ignores is no news for a drawing
             warnings.simplefilter("ignore", RobodynWarning)
@@ -112,6 +116,47 @@ def visuals(source, model=None, *, floating_base: bool = False, package_dirs=())
         pose = homogeneous(R, p) @ homogeneous(rpy_to_matrix(v.rpy), v.xyz)
         out.append(VisualShape(f"{v.link}_{k}", v.link, int(b), pose, v.kind, tuple(v.size), mesh,
                                np.asarray(v.scale, dtype=float), v.rgba))
+    return out
+
+
+def is_mjcf(source) -> bool:
+    """Whether ``source`` is an MJCF file (a path ending in ``.xml`` or ``.mjcf``, as the
+    command line takes them) or MJCF text (its first element ``<mujoco>``)."""
+    if isinstance(source, bytes):
+        source = source[:4096].decode("utf-8", "replace")
+    if is_xml_text(source):
+        first = re.search(r"<\s*([A-Za-z_][\w.:-]*)", re.sub(r"<\?.*?\?>|<!--.*?-->", "", source[:4096], flags=re.S))
+        return first is not None and first.group(1) == "mujoco"
+    return str(source).lower().endswith((".xml", ".mjcf"))
+
+
+def mjcf_visuals(source, model=None) -> list[VisualShape]:
+    """The geoms of an MJCF file (path) or XML string as :class:`VisualShape` records on the
+    bodies of ``model`` (default: ``load_mjcf(source)``), read by
+    :func:`robodyn.io.mjcf.read_mjcf_visuals` (the geoms MuJoCo shows by default, named by
+    their ``name`` or ``<body>_<k>``); a geom whose body the model lacks or whose mesh file is
+    missing is left out with a :class:`RobodynWarning`."""
+    from ..io.mjcf import load_mjcf, read_mjcf_visuals
+
+    if model is None:
+        with warnings.catch_warnings():  # what the loader ignores is no news for a drawing
+            warnings.simplefilter("ignore", RobodynWarning)
+            model = load_mjcf(source)
+    out = []
+    for g in read_mjcf_visuals(source):
+        try:
+            b, R, p = (-1, np.eye(3), np.zeros(3)) if g.link == "world" else model.frame_index(g.link)
+        except ValueError:
+            warnings.warn(f"{g.where}: body {g.link!r} is not in the model; its geom is not drawn", RobodynWarning,
+                          stacklevel=2)
+            continue
+        mesh = None if g.filename is None else Path(g.filename)
+        if mesh is not None and not mesh.is_file():
+            warnings.warn(f"{g.where}: mesh file {g.filename!r} not found; this geom is not drawn", RobodynWarning,
+                          stacklevel=2)
+            continue
+        out.append(VisualShape(g.name, g.link, int(b), homogeneous(R, p) @ homogeneous(g.R, g.p), g.kind, g.size,
+                               mesh, g.scale, g.rgba))
     return out
 
 
@@ -229,7 +274,10 @@ def shape_mesh(shape: VisualShape, cache: dict | None = None, resolution: int = 
 def load_mesh_file(path) -> Mesh:
     """The triangles of a mesh file (every part of a scene, placed by the file's node
     transforms), with each part's colour (its material's main colour, or its face colours),
-    ``DEFAULT_RGBA`` where the file has none. Needs trimesh (and pycollada for DAE)."""
+    ``DEFAULT_RGBA`` where the file has none. Needs trimesh (and pycollada for DAE); MuJoCo's
+    own ``.msh`` files are read here (:func:`load_msh`)."""
+    if Path(path).suffix.lower() == ".msh":
+        return load_msh(path)
     trimesh = require("trimesh")
     loaded = trimesh.load(str(path))
     parts = loaded.dump() if isinstance(loaded, trimesh.Scene) else [loaded]
@@ -244,6 +292,29 @@ def load_mesh_file(path) -> Mesh:
     if not faces:
         raise ValueError("no triangles in the file")
     return Mesh(np.concatenate(vertices), np.concatenate(faces), np.concatenate(colors))
+
+
+def load_msh(path) -> Mesh:
+    """The triangles of MuJoCo's legacy binary mesh file (``.msh``): four little-endian int32
+    counts (vertices, normals, texture coordinates, faces), then float32 vertices (nv, 3),
+    normals (nn, 3), texture coordinates (nt, 2) and int32 vertex indices of the faces (nf,
+    3); grey. ValueError when the size does not match the header, an index is out of range,
+    or there are no faces (MuJoCo would draw the convex hull)."""
+    data = Path(path).read_bytes()
+    if len(data) < 16:
+        raise ValueError(f"{len(data)} bytes: a .msh file starts with a 16-byte header")
+    nv, nn, nt, nf = (int(n) for n in np.frombuffer(data[:16], "<i4"))
+    floats = 3 * nv + 3 * nn + 2 * nt
+    if min(nv, nn, nt, nf) < 0 or len(data) != 16 + 4 * (floats + 3 * nf):
+        raise ValueError(f"{len(data)} bytes do not hold the {nv} vertices, {nn} normals, {nt} texture "
+                         f"coordinates and {nf} faces of its header")
+    if nf == 0:
+        raise ValueError("no triangles in the file")
+    vertices = np.frombuffer(data, "<f4", 3 * nv, offset=16).reshape(nv, 3).astype(float)
+    faces = np.frombuffer(data, "<i4", 3 * nf, offset=16 + 4 * floats).reshape(nf, 3).astype(np.int64)
+    if faces.min() < 0 or faces.max() >= nv:
+        raise ValueError(f"a face index outside the {nv} vertices")
+    return Mesh(vertices, faces, np.tile(DEFAULT_RGBA, (nf, 1)))
 
 
 def _part_colors(part) -> np.ndarray:
