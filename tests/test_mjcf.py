@@ -681,3 +681,6 @@ def test_drawn_geoms_of_a_scene_with_classes_frames_and_scaled_meshes(tmp_path):
     np.testing.assert_array_equal(geoms[3].scale, [1, 1, 1])
     assert geoms[1].filename == str(tmp_path / "shapes" / "wedge.obj")
     _assert_drawn_as_mujoco(path, 7)
+    path.write_text(SCENE.replace('scale="2 1 0.5"', 'scale="2 x 0.5"'))  # drawing is forgiving: the rest is drawn
+    with pytest.warns(rd.RobodynWarning, match=r"scale='2 x 0.5' is not a list of numbers; .*mesh 'wedge' is not "):
+        assert [g.name for g in read_mjcf_visuals(path)] == ["post", "tip", "arm_1", "hand_0"]

@@ -246,17 +246,17 @@ class _Visuals:
             c.update(e.attrib)
         mesh_dir = base / c.get("meshdir", c.get("assetdir", ""))
         self.meshes, self.materials = {}, {}
-        for asset in root.findall("asset"):
-            for m in asset.findall("mesh"):
+        for m in (m for asset in root.findall("asset") for m in asset if m.tag in ("mesh", "material")):
+            try:
                 a = reader.attrs(m, "main")
-                if "file" not in a:
-                    continue  # vertices in the file itself: not read
-                file = Path(a["file"])
-                key = m.get("name") or file.stem
-                self.meshes[key] = (mesh_dir / file, doc.floats(m, a, "scale", 3, (1.0, 1.0, 1.0)))
-            for m in asset.findall("material"):
-                if m.get("name") and "rgba" in m.attrib:
-                    self.materials[m.get("name")] = doc.floats(m, m.attrib, "rgba", 4)
+                if m.tag == "material" and m.get("name") and "rgba" in a:
+                    self.materials[m.get("name")] = doc.floats(m, a, "rgba", 4)
+                elif m.tag == "mesh" and "file" in a:  # (vertices in the XML itself are not read)
+                    file = Path(a["file"])
+                    self.meshes[m.get("name") or file.stem] = (mesh_dir / file,
+                                                               doc.floats(m, a, "scale", 3, (1.0, 1.0, 1.0)))
+            except ModelError as e:  # its geoms are then named as not drawn
+                self.skipped.append(str(e))
 
     def collect(self, elem, link: str, pre, cls: str) -> None:
         """The geoms of body (or frame) ``elem`` whose frame sits at ``pre`` in ``link``'s."""
