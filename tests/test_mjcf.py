@@ -571,7 +571,7 @@ def test_mutated_models_load_or_raise_model_error(rel):
 
 
 # -- the geoms the viewer draws (robodyn.viewer.mjcf_visuals) -------------------------------------
-_DRAWN = {2: "sphere", 3: "capsule", 5: "cylinder", 6: "box", 7: "mesh"}  # mjtGeom -> VisualShape kind
+_DRAWN = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box", 7: "mesh"}  # mjtGeom -> VisualShape kind
 # MuJoCo's geom quaternions given in a default class differ from the file's (normalised) by up to 3e-7
 _CLASS_QUATERNIONS = {"dm_control/mjcf/test_assets/robot_arm.xml", "dm_control/mujoco/testing/assets/arm.xml"}
 
@@ -615,7 +615,8 @@ def _assert_drawn_as_mujoco(path, seed: int, turn: float = 1e-9):
             continue
         size = mm.geom_size[i]
         np.testing.assert_allclose(s.size, {"sphere": size[:1], "capsule": [size[0], 2 * size[1]],
-                                            "cylinder": [size[0], 2 * size[1]], "box": 2 * size}[s.kind], rtol=1e-12)
+                                            "cylinder": [size[0], 2 * size[1]], "box": 2 * size,
+                                            "ellipsoid": size}[s.kind], rtol=1e-12)
         np.testing.assert_allclose(T[:3, 3], d.geom_xpos[i], rtol=0, atol=1e-9 * max(1.0, np.abs(d.geom_xpos[i]).max()))
         if s.kind != "sphere":
             np.testing.assert_allclose(T[:3, :3], R, rtol=0, atol=turn)
@@ -628,6 +629,7 @@ SCENE = """<mujoco model="scene">
     <mesh name="wedge" file="wedge.obj" scale="2 1 0.5"/>
     <mesh file="block.obj"/>
     <material name="steel" rgba="0.3 0.4 0.5 1"/>
+    <hfield name="ground" nrow="2" ncol="2" size="0.1 0.1 0.05 0.01"/>
   </asset>
   <default>
     <default class="collision"><geom group="3" rgba="1 0 0 1"/></default>
@@ -642,6 +644,7 @@ SCENE = """<mujoco model="scene">
       <geom class="collision" type="capsule" fromto="0 0 0 0.5 0 0" size="0.05"/>
       <geom class="visual" type="mesh" mesh="wedge" pos="0.2 0 0" quat="0.9 0.1 0.3 0.2"/>
       <geom type="ellipsoid" size="0.1 0.2 0.3"/>
+      <geom type="hfield" hfield="ground"/>
       <frame pos="0.5 0 0" euler="0 0.5 0">
         <geom name="tip" type="box" fromto="0 0 0 0 0 0.2" size="0.03" rgba="0 1 0 1"/>
         <geom type="mesh" mesh="block"/>
@@ -661,8 +664,8 @@ WEDGE = "v 0 0 0\nv 0.3 0 0\nv 0 0.2 0\nv 0.05 0.05 0.4\nf 1 3 2\nf 1 2 4\nf 2 3
 def test_drawn_geoms_of_a_scene_with_classes_frames_and_scaled_meshes(tmp_path):
     """Groups from default classes (the collision class hidden), a material's colour, a mesh
     scaled and found in ``meshdir`` (and one named after its file), a ``fromto`` box in a
-    ``<frame>``, world geoms: as MuJoCo places them; the plane left out silently, the
-    ellipsoid with a warning."""
+    ``<frame>``, world geoms: as MuJoCo places them; the plane left out silently, the height
+    field with a warning."""
     from robodyn.io.mjcf import read_mjcf_visuals
 
     (tmp_path / "shapes").mkdir()
@@ -670,17 +673,17 @@ def test_drawn_geoms_of_a_scene_with_classes_frames_and_scaled_meshes(tmp_path):
         (tmp_path / "shapes" / f"{name}.obj").write_text(WEDGE)
     path = tmp_path / "scene.xml"
     path.write_text(SCENE)
-    with pytest.warns(rd.RobodynWarning, match=r"geoms not drawn: .*<geom> \(line 20\): type 'ellipsoid'") as caught:
+    with pytest.warns(rd.RobodynWarning, match=r"geoms not drawn: .*<geom> \(line 22\): type 'hfield'") as caught:
         geoms = read_mjcf_visuals(path)
     assert len(caught) == 1 and "plane" not in str(caught[0].message)
     assert [(g.link, g.name, g.kind) for g in geoms] == [
-        ("world", "post", "box"), ("arm", "arm_0", "mesh"), ("arm", "tip", "box"), ("arm", "arm_2", "mesh"),
-        ("hand", "hand_0", "cylinder")]
+        ("world", "post", "box"), ("arm", "arm_0", "mesh"), ("arm", "arm_1", "ellipsoid"), ("arm", "tip", "box"),
+        ("arm", "arm_3", "mesh"), ("hand", "hand_0", "cylinder")]
     np.testing.assert_array_equal(geoms[1].rgba, [0.3, 0.4, 0.5, 1])
     np.testing.assert_array_equal(geoms[1].scale, [2, 1, 0.5])
-    np.testing.assert_array_equal(geoms[3].scale, [1, 1, 1])
+    np.testing.assert_array_equal(geoms[4].scale, [1, 1, 1])
     assert geoms[1].filename == str(tmp_path / "shapes" / "wedge.obj")
     _assert_drawn_as_mujoco(path, 7)
     path.write_text(SCENE.replace('scale="2 1 0.5"', 'scale="2 x 0.5"'))  # drawing is forgiving: the rest is drawn
     with pytest.warns(rd.RobodynWarning, match=r"scale='2 x 0.5' is not a list of numbers; .*mesh 'wedge' is not "):
-        assert [g.name for g in read_mjcf_visuals(path)] == ["post", "tip", "arm_1", "hand_0"]
+        assert [g.name for g in read_mjcf_visuals(path)] == ["post", "arm_0", "tip", "arm_2", "hand_0"]

@@ -197,6 +197,7 @@ def test_visuals_keep_the_hardened_xml_reader():
     ("cylinder", (0.1, 0.5), np.pi * 0.1 ** 2 * 0.5),
     ("sphere", (0.2,), 4 / 3 * np.pi * 0.2 ** 3),
     ("capsule", (0.1, 0.3), np.pi * 0.1 ** 2 * 0.3 + 4 / 3 * np.pi * 0.1 ** 3),
+    ("ellipsoid", (0.1, 0.2, 0.3), 4 / 3 * np.pi * 0.1 * 0.2 * 0.3),
 ])
 def test_primitives_are_closed_outward_surfaces(kind, size, volume):
     """Volume by the divergence theorem (sum of signed tetrahedra): positive (faces wound

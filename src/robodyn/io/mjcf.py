@@ -200,9 +200,9 @@ class GeomVisual(NamedTuple):
     """One drawable ``<geom>`` of an MJCF file: ``link`` the body it belongs to (``"world"``
     for the ``<worldbody>``'s own), ``index`` its geom number in MuJoCo's model (``mjModel``'s
     geom id: every geom in body order), ``name`` its name or ``<link>_<k>``, ``kind`` one of
-    ``sphere``, ``capsule``, ``cylinder``, ``box``, ``mesh``, ``size`` as the viewer takes
-    it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its sphere centres;
-    a box's three edges; ``()`` for a mesh), ``filename`` the mesh file (None for the
+    ``sphere``, ``capsule``, ``cylinder``, ``box``, ``ellipsoid``, ``mesh``, ``size`` as the
+    viewer takes it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its
+    sphere centres; a box's three edges; an ellipsoid's semi-axes; ``()`` for a mesh), ``filename`` the mesh file (None for the
     others), ``R`` (3, 3), ``p`` (3,) the geom frame in the link frame, ``scale`` (3,) the
     mesh's, ``rgba`` (4,) or None (the file gives no colour), ``where`` file and line."""
     link: str
@@ -224,7 +224,7 @@ def read_mjcf_visuals(source) -> list[GeomVisual]:
     left out). Mesh files come
     from ``<asset><mesh file scale>`` in ``<compiler meshdir>`` (or ``assetdir``), relative
     to the file's folder; colours from the geom's ``rgba`` (its class's) or its
-    ``<material rgba>``. Height fields, ellipsoids and SDFs are not drawn; they and a
+    ``<material rgba>``. Height fields and SDFs are not drawn; they and a
     geom that cannot be drawn (a mesh without a file, an unknown mesh) are left out with one
     :class:`RobodynWarning` naming them. Errors of the body tree are the loader's."""
     _, doc, reader = _read_tree(source, visuals=True)
@@ -278,7 +278,7 @@ class _Visuals:
             return
         if kind == "plane":
             return  # the ground: a viewer draws its own
-        if kind not in ("sphere", "capsule", "cylinder", "box", "mesh"):
+        if kind not in ("sphere", "capsule", "cylinder", "box", "ellipsoid", "mesh"):
             raise ModelError(f"{doc.where(g)}: type {kind!r}")
         size = np.zeros(3)
         if kind != "mesh":
@@ -286,7 +286,7 @@ class _Visuals:
             size[: given.size] = given
         if "fromto" in a and kind != "mesh":
             pose, half = self.reader.fromto(g, a)
-            size[1:] = (size[0], half) if kind == "box" else (half, 0.0)
+            size[1:] = (size[0], half) if kind in ("box", "ellipsoid") else (half, 0.0)
         else:
             pose = self.reader.pose(g, a)
         filename, scale = None, np.ones(3)
@@ -296,7 +296,7 @@ class _Visuals:
             path, scale = self.meshes[a["mesh"]]
             filename = str(path)
         shape = {"sphere": (size[0],), "capsule": (size[0], 2 * size[1]), "cylinder": (size[0], 2 * size[1]),
-                 "box": tuple(2 * size), "mesh": ()}[kind]
+                 "box": tuple(2 * size), "ellipsoid": tuple(size), "mesh": ()}[kind]
         if any(not x > 0 for x in shape):
             raise ModelError(f"{doc.where(g)}: size {shape} is not positive")
         rgba = doc.floats(g, a, "rgba", 4) if "rgba" in a else self.materials.get(a.get("material"))

@@ -34,7 +34,7 @@ from ..io.urdf import is_xml_text
 DEFAULT_RGBA = np.array([0.72, 0.74, 0.78, 1.0])  # geometry the file gives no colour
 LINK_RGBA = np.array([0.56, 0.64, 0.74, 1.0])  # skeleton segments
 JOINT_RGBA = np.array([0.96, 0.62, 0.22, 1.0])  # skeleton joints
-KINDS = ("box", "cylinder", "sphere", "capsule", "mesh")
+KINDS = ("box", "cylinder", "sphere", "capsule", "ellipsoid", "mesh")
 
 
 def require(module: str):
@@ -54,8 +54,8 @@ class VisualShape(NamedTuple):
     the body index in the model after fixed-joint merging (-1: fixed to the world); ``pose``
     (4, 4): the geometry frame in the body frame; ``kind``: one of ``KINDS``; ``size``:
     ``(radius,)`` for a sphere, ``(radius, length)`` along the local z axis for a cylinder or
-    a capsule (length between the two sphere centres), the three edges of a box, ``()`` for a
-    mesh; ``mesh``: the resolved mesh file (or None); ``scale`` (3,): the mesh's scale per
+    a capsule (length between the two sphere centres), the three edges of a box, the three
+    semi-axes of an ellipsoid, ``()`` for a mesh; ``mesh``: the resolved mesh file (or None); ``scale`` (3,): the mesh's scale per
     axis; ``rgba`` (4,) in [0, 1], or None: the mesh file's own colours (else grey)."""
     name: str
     link: str
@@ -264,6 +264,9 @@ def shape_mesh(shape: VisualShape, cache: dict | None = None, resolution: int = 
         mesh = _box(np.asarray(shape.size, dtype=float))
     elif shape.kind in ("cylinder", "capsule", "sphere"):
         mesh = _revolution(shape.kind, shape.size, resolution)
+    elif shape.kind == "ellipsoid":  # the unit sphere stretched along its axes
+        mesh = _revolution("sphere", (1.0,), resolution)
+        mesh = mesh._replace(vertices=mesh.vertices * np.asarray(shape.size, dtype=float))
     else:
         raise ValueError(f"{shape.name}: unknown geometry kind {shape.kind!r}; expected one of {KINDS}")
     if shape.rgba is not None:
