@@ -594,7 +594,7 @@ def _assert_drawn_as_mujoco(path, seed: int, turn: float = 1e-9):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
         geoms, shapes = read_mjcf_visuals(path), mjcf_visuals(path, model)
-    expected = [i for i in range(mm.ngeom) if mm.geom_group[i] <= 2 and int(mm.geom_type[i]) in _DRAWN]
+    expected = [i for i in range(mm.ngeom) if np.clip(mm.geom_group[i], 0, 5) <= 2 and int(mm.geom_type[i]) in _DRAWN]
     assert [g.index for g in geoms] == expected and [s.name for s in shapes] == [g.name for g in geoms]
     d = mujoco.MjData(mm)
     d.qpos[:] = _random_qpos(mm, np.random.default_rng(seed))
@@ -637,7 +637,7 @@ SCENE = """<mujoco model="scene">
   </default>
   <worldbody>
     <geom type="plane" size="2 2 0.1"/>
-    <geom name="post" type="box" size="0.1 0.2 0.3" pos="1 0 0.3" euler="0.1 0.2 0.3"/>
+    <geom name="post" type="box" size="0.1 0.2 0.3" pos="1 0 0.3" euler="0.1 0.2 0.3" group="-1"/>
     <body name="arm" pos="0 0 1">
       <joint type="hinge" axis="0 1 0"/>
       <inertial pos="0.25 0 0" mass="1" diaginertia="0.01 0.02 0.025"/>

@@ -497,3 +497,15 @@ def test_mujoco_msh_meshes_are_read_and_bad_ones_refused(tmp_path):
     shape = VisualShape("m", "world", -1, np.eye(4), "mesh", (), bad, np.ones(3), None)
     with pytest.warns(RobodynWarning, match="bad.msh .*cannot be read"):
         assert shape_mesh(shape) is None
+
+
+def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):
+    """The first element decides: a ``.xml`` file holding ``<robot>`` is a URDF."""
+    from robodyn.viewer.geometry import is_mjcf
+
+    path = tmp_path / "robot.xml"
+    path.write_text('<?xml version="1.0"?><!-- <mujoco> --><robot name="r"><link name="a"><visual><geometry>'
+                    '<box size="1 2 3"/></geometry></visual></link></robot>')
+    assert not is_mjcf(path) and is_mjcf("<mujoco/>") and not is_mjcf("x.urdf")
+    [shape] = visuals(path, quiet_load(path))
+    assert shape.kind == "box" and shape.size == (1.0, 2.0, 3.0)

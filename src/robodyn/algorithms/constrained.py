@@ -393,7 +393,7 @@ def constrained_dynamics(model, q, v, tau, constraints, baumgarte=(0.0, 0.0), *,
     Returns:
         :class:`ConstrainedDynamics` ``(a, forces, rank)``. Without constraints ``a`` equals
         ``aba(q, v, tau)``. With ``check_finite=False`` a state with NaN or Inf gets NaN
-        (rank 0), the others their own results.
+        (rank 0 when its ``q`` is not finite), the others their own results.
 
     Raises ValueError for bad shapes or values, unknown bodies or joints, and a mass matrix
     that is not positive definite. Reference: Featherstone, RBDA (2008), chapter 8;

@@ -274,7 +274,7 @@ class _Visuals:
     def geom(self, g, a, link: str, pre, index: int) -> None:
         doc = self.doc
         kind = a.get("type", "sphere")
-        if int(doc.number(g, a, "group", 0)) not in self.DEFAULT_GROUPS:
+        if min(max(int(doc.number(g, a, "group", 0)), 0), 5) not in self.DEFAULT_GROUPS:  # clamped as MuJoCo
             return
         if kind == "plane":
             return  # the ground: a viewer draws its own

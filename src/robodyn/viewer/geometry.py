@@ -120,14 +120,20 @@ def visuals(source, model=None, *, floating_base: bool = False, package_dirs=())
 
 
 def is_mjcf(source) -> bool:
-    """Whether ``source`` is an MJCF file (a path ending in ``.xml`` or ``.mjcf``, as the
-    command line takes them) or MJCF text (its first element ``<mujoco>``)."""
+    """Whether ``source`` is MJCF: text (or a file ending in ``.xml`` or ``.mjcf``) whose
+    first element is ``<mujoco>``."""
     if isinstance(source, bytes):
         source = source[:4096].decode("utf-8", "replace")
-    if is_xml_text(source):
-        first = re.search(r"<\s*([A-Za-z_][\w.:-]*)", re.sub(r"<\?.*?\?>|<!--.*?-->", "", source[:4096], flags=re.S))
-        return first is not None and first.group(1) == "mujoco"
-    return str(source).lower().endswith((".xml", ".mjcf"))
+    elif not is_xml_text(source):
+        if not str(source).lower().endswith((".xml", ".mjcf")):
+            return False
+        try:  # a URDF may be saved as .xml too: its first element decides
+            with open(source, "rb") as f:
+                source = f.read(4096).decode("utf-8", "replace")
+        except OSError:
+            return True  # the MJCF reader names the file it cannot read
+    first = re.search(r"<\s*([A-Za-z_][\w.:-]*)", re.sub(r"<\?.*?\?>|<!--.*?-->", "", source, flags=re.S))
+    return first is not None and first.group(1) == "mujoco"
 
 
 def mjcf_visuals(source, model=None) -> list[VisualShape]:
