@@ -96,12 +96,34 @@ def test_threaded_workers_one_per_thread_and_chunk(monkeypatch, threads, nchunk,
     np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
 
 
-def test_an_exception_in_a_threaded_worker_reaches_the_caller():
-    """A workspace too large to allocate, in every worker: the caller gets Numba's error."""
+@kernel
+def _first_workspace_too_big(calls):
+    """Numba's "array is too big" for the first worker that asks, a workspace for the others."""
+    calls[0] += 1
+    return np.empty(2 ** 62 if calls[0] == 1 else 1)
+
+
+_first_fails_batch = threaded_batch_kernel(_affine_at, _first_workspace_too_big)
+
+
+class _FinishedThread(driver.threading.Thread):
+    """Runs to its end before the caller goes on: the spawned worker asks first."""
+
+    def start(self):
+        super().start()
+        self.join()
+
+
+def test_an_exception_in_a_threaded_worker_reaches_the_caller(monkeypatch):
+    """Only the spawned thread fails (the caller's worker computes every state): its error is
+    raised in the caller all the same."""
+    monkeypatch.setattr(driver.threading, "Thread", _FinishedThread)
+    monkeypatch.setattr(driver.numba, "get_num_threads", lambda: 2)
     X = np.ones((50, 2))
-    status = np.full(50, 99, np.int64)
+    Y, status, calls = np.empty_like(X), np.full(50, 99, np.int64), np.zeros(1, np.int64)
     with pytest.raises(ValueError, match="array is too big"):
-        _threaded_batch((X, np.empty_like(X)), (2 ** 62,), status, 4)
+        _first_fails_batch((X, Y), (calls,), status, 4)
+    assert calls[0] == 2 and (status == 0).all()  # the caller's worker did the work
 
 
 KEY = """

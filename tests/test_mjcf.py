@@ -584,6 +584,18 @@ def test_drawn_geoms_are_mujocos(rel):
     _assert_drawn_as_mujoco(CORPUS[rel], zlib.crc32(rel.encode()), 1e-6 if rel in _CLASS_QUATERNIONS else 1e-9)
 
 
+_GREY = (0.5, 0.5, 0.5, 1.0)  # MuJoCo's geom colour when the file gives none (robodyn: rgba None)
+
+
+def _mujoco_scene_colours(mm, d) -> dict:
+    """``{geom id: rgba}`` of the geoms MuJoCo's own visualiser puts in a scene (default
+    options: groups 0-2, transparent geoms left out, colours after the materials)."""
+    scene = mujoco.MjvScene(mm, maxgeom=max(1000, 2 * mm.ngeom))
+    mujoco.mjv_updateScene(mm, d, mujoco.MjvOption(), None, mujoco.MjvCamera(), mujoco.mjtCatBit.mjCAT_ALL, scene)
+    return {g.objid: np.array(g.rgba, dtype=float) for g in scene.geoms[:scene.ngeom]
+            if g.objtype == mujoco.mjtObj.mjOBJ_GEOM}
+
+
 def _assert_drawn_as_mujoco(path, seed: int, turn: float = 1e-9):
     from scipy.spatial import cKDTree
 
@@ -594,17 +606,18 @@ def _assert_drawn_as_mujoco(path, seed: int, turn: float = 1e-9):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", rd.RobodynWarning)
         geoms, shapes = read_mjcf_visuals(path), mjcf_visuals(path, model)
-    expected = [i for i in range(mm.ngeom) if np.clip(mm.geom_group[i], 0, 5) <= 2 and int(mm.geom_type[i]) in _DRAWN]
-    assert [g.index for g in geoms] == expected and [s.name for s in shapes] == [g.name for g in geoms]
     d = mujoco.MjData(mm)
     d.qpos[:] = _random_qpos(mm, np.random.default_rng(seed))
     mujoco.mj_kinematics(mm, d)
+    colours = _mujoco_scene_colours(mm, d)
+    expected = [i for i in colours if int(mm.geom_type[i]) in _DRAWN]
+    assert [g.index for g in geoms] == expected and [s.name for s in shapes] == [g.name for g in geoms]
+    assert len({g.name for g in geoms}) == len(geoms)
     poses = visual_poses(model, shapes, rd.interop.mujoco.qpos_to_q(model, d.qpos))
     for g, s, T in zip(geoms, shapes, poses):
         i, R = g.index, d.geom_xmat[g.index].reshape(3, 3)
         assert s.kind == _DRAWN[int(mm.geom_type[i])]
-        if g.rgba is not None and mm.geom_matid[i] < 0:
-            np.testing.assert_allclose(g.rgba, mm.geom_rgba[i], rtol=1e-7)
+        np.testing.assert_allclose(_GREY if g.rgba is None else g.rgba, colours[i], rtol=1e-7, err_msg=g.name)
         if s.kind == "mesh":  # MuJoCo moves a mesh's vertices to its inertia frame, and the geom frame with them
             k = mm.geom_dataid[i]
             theirs = mm.mesh_vert[mm.mesh_vertadr[k]:mm.mesh_vertadr[k] + mm.mesh_vertnum[k]] @ R.T + d.geom_xpos[i]
@@ -659,6 +672,60 @@ SCENE = """<mujoco model="scene">
 """
 
 WEDGE = "v 0 0 0\nv 0.3 0 0\nv 0 0.2 0\nv 0.05 0.05 0.4\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n"
+
+
+ORDERED = """<mujoco>
+  <compiler meshdir="a"/>
+  <compiler assetdir="b" strippath="true"/>
+  <asset>
+    <mesh name="wedge" file="some/where/wedge.obj"/>
+    <material name="plain"/>
+    <material name="red" rgba="1 0 0 1"/>
+  </asset>
+  <worldbody>
+    <geom name="arm_0" size="0.1" pos="2 0 0"/>
+    <body name="arm">
+      <joint type="hinge"/>
+      <inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/>
+      <geom type="mesh" mesh="wedge" material="red"/>
+      <geom name="arm_2" size="0.1" material="plain"/>
+      <geom size="0.1" material="red" rgba="0 0 1 1"/>
+      <geom size="0.1" material="red" rgba="0.5 0.5 0.5 1"/>
+      <geom size="0.1" rgba="0 1 0 0"/>
+      <geom type="box" mesh="wedge"/>
+      <geom size="0.1"/>
+    </body>
+  </worldbody>
+</mujoco>
+"""
+
+
+def test_drawn_geoms_follow_mujocos_compiler_order_colours_and_names(tmp_path):
+    """The last ``<compiler>`` directory wins (``assetdir`` after ``meshdir``) and
+    ``strippath`` drops the file's folders; colours as MuJoCo's own scene (a material's unless
+    the geom's rgba is not the default; a material without rgba white; a transparent geom not
+    drawn); a primitive fitted to a mesh left out with a warning; generated names never take
+    a name the file uses."""
+    from robodyn.io.mjcf import read_mjcf_visuals
+
+    for folder in ("a", "b"):
+        (tmp_path / folder).mkdir()
+    (tmp_path / "b" / "wedge.obj").write_text(WEDGE)
+    path = tmp_path / "ordered.xml"
+    path.write_text(ORDERED)
+    with pytest.warns(rd.RobodynWarning, match=r"geoms not drawn: .*line 19\): a box fitted to mesh 'wedge'"):
+        geoms = read_mjcf_visuals(path)
+    assert geoms[1].filename == str(tmp_path / "b" / "wedge.obj")
+    assert [g.name for g in geoms] == ["arm_0", "arm_0_1", "arm_2", "arm_2_1", "arm_3", "arm_4"]
+    mm = mujoco.MjModel.from_xml_path(str(path))
+    d = mujoco.MjData(mm)
+    mujoco.mj_kinematics(mm, d)
+    colours = _mujoco_scene_colours(mm, d)
+    fitted = 6
+    assert [g.index for g in geoms] == [i for i in colours if i != fitted]
+    for g in geoms:
+        np.testing.assert_allclose(_GREY if g.rgba is None else g.rgba, colours[g.index], err_msg=g.name)
+    assert [tuple(g.rgba) for g in geoms[1:5]] == [(1, 0, 0, 1), (1, 1, 1, 1), (0, 0, 1, 1), (1, 0, 0, 1)]
 
 
 def test_drawn_geoms_of_a_scene_with_classes_frames_and_scaled_meshes(tmp_path):

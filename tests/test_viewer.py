@@ -499,6 +499,22 @@ def test_mujoco_msh_meshes_are_read_and_bad_ones_refused(tmp_path):
         assert shape_mesh(shape) is None
 
 
+def test_cli_view_draws_msh_meshes_without_trimesh(tmp_path, capsys, monkeypatch):
+    """MuJoCo's ``.msh`` is read here: ``robodyn view`` needs trimesh only for other meshes."""
+    monkeypatch.setitem(sys.modules, "trimesh", None)
+    (tmp_path / "tet.msh").write_bytes(_msh([[0, 0, 0], [1, 0, 0], [0, 2, 0], [0, 0, 3]],
+                                            [[0, 2, 1], [0, 1, 3], [1, 2, 3], [2, 0, 3]]))
+    (tmp_path / "tet.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 2 0\nv 0 0 3\nf 1 3 2\nf 1 2 4\nf 2 3 4\nf 3 1 4\n")
+    xml = ('<mujoco><asset><mesh file="tet.{}"/></asset><worldbody><body name="b"><joint/>'
+           '<inertial pos="0 0 0" mass="1" diaginertia="1 1 1"/><geom type="mesh" mesh="tet"/></body></worldbody></mujoco>')
+    path, png = tmp_path / "tet.xml", tmp_path / "tet.png"
+    path.write_text(xml.format("msh"))
+    assert main(["view", str(path), "--png", str(png)]) == 0 and pixels(png).shape == (600, 800, 3)
+    path.write_text(xml.format("obj"))
+    assert main(["view", str(path), "--png", str(png)]) == 2
+    assert 'robodyn view needs trimesh: pip install "robodyn[viewer]"' in capsys.readouterr().err
+
+
 def test_a_urdf_saved_as_xml_is_read_as_a_urdf(tmp_path):
     """The first element decides: a ``.xml`` file holding ``<robot>`` is a URDF."""
     from robodyn.viewer.geometry import is_mjcf

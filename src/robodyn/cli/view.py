@@ -47,7 +47,7 @@ def cmd_view(args) -> int:
         named = not (args.model.lower().endswith((".urdf", ".xml", ".mjcf")) or "/" in args.model)
         source = models.example_robot_urdf(args.model) if named else args.model
         visuals = read_visuals(source, model, package_dirs=args.package_dir)
-        if any(v.kind == "mesh" for v in visuals):
+        if any(v.kind == "mesh" and v.mesh.suffix.lower() != ".msh" for v in visuals):  # .msh: read without it
             _extra("trimesh")
     trajectory = None
     if args.trajectory:

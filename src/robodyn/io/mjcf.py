@@ -51,6 +51,7 @@ forbidden, size and depth bounded, at most ``MAX_INCLUDES`` included files.
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections import Counter
 from dataclasses import dataclass
@@ -79,6 +80,7 @@ _BODY_SILENT = {"camera", "light", "plugin"}
 _GENERATORS = {"composite", "flexcomp", "replicate", "attach"}
 _ORIENTATIONS = ("quat", "axisangle", "euler", "xyaxes", "zaxis")
 _EPS = 1e-14  # mjEPS
+_DEFAULT_RGBA = np.array([0.5, 0.5, 0.5, 1.0], np.float32)  # a geom's rgba when the file gives none
 
 
 @dataclass
@@ -199,12 +201,15 @@ def _read_tree(source, visuals: bool = False):
 class GeomVisual(NamedTuple):
     """One drawable ``<geom>`` of an MJCF file: ``link`` the body it belongs to (``"world"``
     for the ``<worldbody>``'s own), ``index`` its geom number in MuJoCo's model (``mjModel``'s
-    geom id: every geom in body order), ``name`` its name or ``<link>_<k>``, ``kind`` one of
-    ``sphere``, ``capsule``, ``cylinder``, ``box``, ``ellipsoid``, ``mesh``, ``size`` as the
-    viewer takes it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its
-    sphere centres; a box's three edges; an ellipsoid's semi-axes; ``()`` for a mesh), ``filename`` the mesh file (None for the
-    others), ``R`` (3, 3), ``p`` (3,) the geom frame in the link frame, ``scale`` (3,) the
-    mesh's, ``rgba`` (4,) or None (the file gives no colour), ``where`` file and line."""
+    geom id: every geom in body order), ``name`` its name or ``<link>_<k>`` (k: its place among
+    the link's drawn geoms; ``_1``, ``_2``, ... appended to a name the file uses), ``kind`` one of ``sphere``,
+    ``capsule``, ``cylinder``, ``box``, ``ellipsoid``, ``mesh``, ``size`` as the viewer takes
+    it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its sphere centres; a
+    box's three edges; an ellipsoid's semi-axes; ``()`` for a mesh), ``filename`` the mesh
+    file (None for the others), ``R`` (3, 3), ``p`` (3,) the geom frame in the link frame,
+    ``scale`` (3,) the mesh's, ``rgba`` (4,) the colour MuJoCo draws or None (neither an rgba
+    nor a material: MuJoCo's grey 0.5 0.5 0.5 1, the viewer's default), ``where`` file and
+    line."""
     link: str
     index: int
     name: str
@@ -219,14 +224,16 @@ class GeomVisual(NamedTuple):
 
 
 def read_mjcf_visuals(source) -> list[GeomVisual]:
-    """The geoms MuJoCo draws by default (``group`` 0, 1 or 2) of an MJCF file (path) or XML
-    string, on the bodies :func:`load_mjcf` reads, in MuJoCo's geom order (planes, the ground,
-    left out). Mesh files come
-    from ``<asset><mesh file scale>`` in ``<compiler meshdir>`` (or ``assetdir``), relative
-    to the file's folder; colours from the geom's ``rgba`` (its class's) or its
-    ``<material rgba>``. Height fields and SDFs are not drawn; they and a
-    geom that cannot be drawn (a mesh without a file, an unknown mesh) are left out with one
-    :class:`RobodynWarning` naming them. Errors of the body tree are the loader's."""
+    """The geoms MuJoCo draws by default (``group`` 0, 1 or 2, not transparent) of an MJCF
+    file (path) or XML string, on the bodies :func:`load_mjcf` reads, in MuJoCo's geom order
+    (planes, the ground, left out). Mesh files come from ``<asset><mesh file scale>`` in the
+    ``<compiler>``'s ``meshdir`` or ``assetdir`` (the last given, as MuJoCo reads them; the
+    file's folder part dropped with ``strippath``), relative to the file's folder. Colours as
+    MuJoCo's viewer: a ``<material>``'s ``rgba`` (white by default) unless the geom's own
+    ``rgba`` (its class's) differs from the default 0.5 0.5 0.5 1. Height fields, SDFs and
+    primitives fitted to a mesh are not drawn; they and a geom that cannot be drawn (a mesh
+    without a file, an unknown mesh) are left out with one :class:`RobodynWarning` naming
+    them. Errors of the body tree are the loader's."""
     _, doc, reader = _read_tree(source, visuals=True)
     v = reader.visuals
     if v.skipped:
@@ -241,19 +248,22 @@ class _Visuals:
 
     def __init__(self, root, doc: _Doc, reader, base: Path):
         self.doc, self.reader, self.out, self.skipped, self.count = doc, reader, [], [], 0
-        c = {}
-        for e in root.findall("compiler"):
-            c.update(e.attrib)
-        mesh_dir = base / c.get("meshdir", c.get("assetdir", ""))
+        self.taken = {g.get("name") for g in root.iter("geom") if g.get("name")}  # the file's own names
+        self.drawn: Counter = Counter()  # drawn geoms per link, for the generated names
+        mesh_dir, strip = "", False
+        for e in root.findall("compiler"):  # in order, as MuJoCo; a meshdir overrides its assetdir
+            mesh_dir = e.get("meshdir", e.get("assetdir", mesh_dir))
+            if "strippath" in e.attrib:
+                strip = doc.flag(e, e.attrib, "strippath", "false") == "true"
         self.meshes, self.materials = {}, {}
         for m in (m for asset in root.findall("asset") for m in asset if m.tag in ("mesh", "material")):
             try:
                 a = reader.attrs(m, "main")
-                if m.tag == "material" and m.get("name") and "rgba" in a:
-                    self.materials[m.get("name")] = doc.floats(m, a, "rgba", 4)
+                if m.tag == "material" and m.get("name"):  # MuJoCo's material colour is white by default
+                    self.materials[m.get("name")] = doc.floats(m, a, "rgba", 4, (1.0, 1.0, 1.0, 1.0))
                 elif m.tag == "mesh" and "file" in a:  # (vertices in the XML itself are not read)
-                    file = Path(a["file"])
-                    self.meshes[m.get("name") or file.stem] = (mesh_dir / file,
+                    file = Path(re.split(r"[/\\]", a["file"])[-1] if strip else a["file"])
+                    self.meshes[m.get("name") or file.stem] = (base / mesh_dir / file,
                                                                doc.floats(m, a, "scale", 3, (1.0, 1.0, 1.0)))
             except ModelError as e:  # its geoms are then named as not drawn
                 self.skipped.append(str(e))
@@ -280,6 +290,8 @@ class _Visuals:
             return  # the ground: a viewer draws its own
         if kind not in ("sphere", "capsule", "cylinder", "box", "ellipsoid", "mesh"):
             raise ModelError(f"{doc.where(g)}: type {kind!r}")
+        if kind != "mesh" and "mesh" in a:
+            raise ModelError(f"{doc.where(g)}: a {kind} fitted to mesh {a['mesh']!r} (sized from the mesh)")
         size = np.zeros(3)
         if kind != "mesh":
             given = doc.floats(g, a, "size", (1, 3), (0.0,))
@@ -299,11 +311,32 @@ class _Visuals:
                  "box": tuple(2 * size), "ellipsoid": tuple(size), "mesh": ()}[kind]
         if any(not x > 0 for x in shape):
             raise ModelError(f"{doc.where(g)}: size {shape} is not positive")
-        rgba = doc.floats(g, a, "rgba", 4) if "rgba" in a else self.materials.get(a.get("material"))
+        rgba = self.colour(g, a)
+        if rgba is not None and rgba[3] == 0:
+            return  # MuJoCo does not draw a transparent geom
         R, p = _compose(pre, pose)
-        k = sum(v.link == link for v in self.out)
-        self.out.append(GeomVisual(link, index, g.get("name") or f"{link}_{k}", kind, shape, filename, R, p,
-                                   np.asarray(scale, dtype=float), rgba, doc.where(g)))
+        k, self.drawn[link] = self.drawn[link], self.drawn[link] + 1
+        self.out.append(GeomVisual(link, index, g.get("name") or self.generated_name(link, k), kind, shape,
+                                   filename, R, p, np.asarray(scale, dtype=float), rgba, doc.where(g)))
+
+    def colour(self, g, a) -> np.ndarray | None:
+        """MuJoCo's (``setMaterial``): the material's rgba unless the geom's own differs from
+        the default 0.5 0.5 0.5 1; None for neither (the viewer's default colour)."""
+        own = self.doc.floats(g, a, "rgba", 4) if "rgba" in a else None
+        if a.get("material") not in self.materials:
+            return own
+        if own is not None and (own.astype(np.float32) != _DEFAULT_RGBA).any():  # compared as MuJoCo's floats
+            return own
+        return self.materials[a["material"]]
+
+    def generated_name(self, link: str, k: int) -> str:
+        """``<link>_<k>`` (``_1``, ``_2``, ... appended while the file or an earlier geom uses it)."""
+        name, n = f"{link}_{k}", 0
+        while name in self.taken:
+            n += 1
+            name = f"{link}_{k}_{n}"
+        self.taken.add(name)
+        return name
 
 
 def _joint_equalities(root, doc: _Doc, reader: _Bodies, ignored: Counter) -> list[tuple]:

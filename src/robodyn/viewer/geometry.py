@@ -55,8 +55,9 @@ class VisualShape(NamedTuple):
     (4, 4): the geometry frame in the body frame; ``kind``: one of ``KINDS``; ``size``:
     ``(radius,)`` for a sphere, ``(radius, length)`` along the local z axis for a cylinder or
     a capsule (length between the two sphere centres), the three edges of a box, the three
-    semi-axes of an ellipsoid, ``()`` for a mesh; ``mesh``: the resolved mesh file (or None); ``scale`` (3,): the mesh's scale per
-    axis; ``rgba`` (4,) in [0, 1], or None: the mesh file's own colours (else grey)."""
+    semi-axes of an ellipsoid, ``()`` for a mesh; ``mesh``: the resolved mesh file (or
+    None); ``scale`` (3,): the mesh's scale per axis; ``rgba`` (4,) in [0, 1], or None: the
+    mesh file's own colours (else grey)."""
     name: str
     link: str
     body: int
@@ -93,9 +94,7 @@ def visuals(source, model=None, *, floating_base: bool = False, package_dirs=())
     if is_mjcf(source):
         return mjcf_visuals(source, model)
     if model is None:
-        with warnings.catch_warnings():  # what the loader ignores is no news for a drawing
-            warnings.simplefilter("ignore", RobodynWarning)
-            model = load_urdf(source, floating_base=floating_base)
+        model = _quietly(load_urdf, source, floating_base=floating_base)
     base = Path.cwd() if is_xml_text(source) or isinstance(source, bytes) else Path(source).resolve().parent
     out, count = [], {}
     for v in read_visuals(source):
@@ -117,6 +116,13 @@ def visuals(source, model=None, *, floating_base: bool = False, package_dirs=())
         out.append(VisualShape(f"{v.link}_{k}", v.link, int(b), pose, v.kind, tuple(v.size), mesh,
                                np.asarray(v.scale, dtype=float), v.rgba))
     return out
+
+
+def _quietly(load, *args, **kwargs):
+    """``load(*args, **kwargs)`` without its warnings: what a loader ignores is no news for a drawing."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RobodynWarning)
+        return load(*args, **kwargs)
 
 
 def is_mjcf(source) -> bool:
@@ -145,9 +151,7 @@ def mjcf_visuals(source, model=None) -> list[VisualShape]:
     from ..io.mjcf import load_mjcf, read_mjcf_visuals
 
     if model is None:
-        with warnings.catch_warnings():  # what the loader ignores is no news for a drawing
-            warnings.simplefilter("ignore", RobodynWarning)
-            model = load_mjcf(source)
+        model = _quietly(load_mjcf, source)
     out = []
     for g in read_mjcf_visuals(source):
         try:
