@@ -26,6 +26,10 @@ dispatcher compiles nothing else: any other argument types (lists, integers, str
 read-only arrays, batches) raise ``TypeError``, on which the public function takes its general
 path.
 
+Every kind is cached on disk through :class:`SharedCache`: Numba's cache, with saves locked
+between processes, so that processes compiling at once into one cache (``robodyn warmup`` on
+every core, the workers of a cluster) never load one another's code for the wrong signature.
+
 All release the GIL (``nogil``), so Python threads run them concurrently (they share no
 state: every call allocates its own workspace). ``error_model="numpy"`` lets divisions by
 zero give inf/nan instead of raising (the kernels check their inputs and pivots themselves);
@@ -33,27 +37,92 @@ zero give inf/nan instead of raising (the kernels check their inputs and pivots 
 finiteness checks stay exact.
 """
 
+import contextlib
+import itertools
+import os
 import threading
 
 from numba import njit
 from numba import types as _types
+from numba.core.caching import FunctionCache, IndexDataCacheFile
+
+try:
+    import fcntl
+except ImportError:  # Windows: saves are not serialised between processes (Numba's own behaviour)
+    fcntl = None
 
 FASTMATH = {"contract", "reassoc", "arcp", "nsz"}
 _BASE = dict(cache=True, error_model="numpy", fastmath=FASTMATH, nogil=True)
 _CALLED = dict(_BASE, forceinline=False)
 
-kernel = njit(**_CALLED)
-parallel = njit(parallel=True, **_CALLED)
-core = njit(_nrt=False, **_CALLED)
-inline = njit(_nrt=False, **dict(_BASE, forceinline=True))
+
+@contextlib.contextmanager
+def _locked(folder: str):
+    """Holds an exclusive lock on ``folder``'s cache (a lock file there) between processes."""
+    if fcntl is None:
+        yield
+        return
+    with open(os.path.join(folder, ".robodyn-cache.lock"), "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
+
+
+class _SharedIndex(IndexDataCacheFile):
+    """Numba's index and data files of one function, saved so that processes compiling at once
+    cannot mix up their code: Numba's ``save`` reads the index, picks the first free data file
+    number and writes the index, then the data, unlocked; two processes saving two signatures
+    of one function at once can both pick number 1, and the index can end up naming the other
+    signature's machine code for a signature (a wrong function loaded later). Here a save
+    holds a lock on the cache folder from reading the index to writing it, and writes the
+    data file before the index that names it (a reader never finds an entry whose data is
+    not yet written, or an older file of that number)."""
+
+    def save(self, key, data):
+        with _locked(self._cache_path):
+            overloads = self._load_index()
+            name = overloads.get(key)
+            if name is None:
+                taken = set(overloads.values())
+                name = next(n for n in map(self._data_name, itertools.count(1)) if n not in taken)
+            self._save_data(name, data)
+            overloads[key] = name
+            self._save_index(overloads)
+
+
+class SharedCache(FunctionCache):
+    """Numba's on-disk cache with :class:`_SharedIndex` files: safe when several processes
+    (a warm-up on every core, workers of a cluster, test runners) compile into one cache."""
+
+    def __init__(self, py_func):
+        super().__init__(py_func)
+        self._cache_file = _SharedIndex(cache_path=self._cache_path, filename_base=self._impl.filename_base,
+                                        source_stamp=self._impl.locator.get_source_stamp())
+
+
+def _jit(**options):
+    """``njit(**options)`` whose dispatchers save to and load from a :class:`SharedCache`."""
+    def decorate(func):
+        dispatcher = njit(**options)(func)
+        dispatcher._cache = SharedCache(dispatcher.py_func)
+        return dispatcher
+    return decorate
+
+
+kernel = _jit(**_CALLED)
+parallel = _jit(parallel=True, **_CALLED)
+core = _jit(_nrt=False, **_CALLED)
+inline = _jit(_nrt=False, **dict(_BASE, forceinline=True))
 # ``splice``: a tiny helper called with many argument types (a workspace's shapes), spliced
 # into each caller's Numba IR (``inline="always"``): cheaper to compile than one machine-code
 # function per argument type. Also a large function with one caller (``rollout_at``): a
 # separately compiled copy would be optimised and emitted once more inside its caller.
-splice = njit(_nrt=False, inline="always", **_CALLED)
+splice = _jit(_nrt=False, inline="always", **_CALLED)
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
 # carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.
-exact = njit(_nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
+exact = _jit(_nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
 
 
 VEC = _types.Array(_types.float64, 1, "C")
@@ -65,7 +134,12 @@ INTS = _types.Array(_types.int64, 1, "C")
 
 def fast(*argtypes):
     """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only."""
-    return njit([_types.int64(*argtypes)], **_CALLED)
+    def decorate(func):
+        dispatcher = kernel(func)
+        dispatcher.compile(_types.int64(*argtypes))
+        dispatcher.disable_compile()
+        return dispatcher
+    return decorate
 
 
 class _FirstCall:
@@ -74,7 +148,7 @@ class _FirstCall:
     __slots__ = ("dispatcher", "signature", "ready", "_lock", "__wrapped__")
 
     def __init__(self, func, signature):
-        self.dispatcher, self.signature, self.ready = njit(**_CALLED)(func), signature, False
+        self.dispatcher, self.signature, self.ready = kernel(func), signature, False
         self._lock = threading.Lock()
         self.__wrapped__ = func
 

@@ -41,10 +41,9 @@ import numba
 import numpy as np
 from llvmlite import ir
 from numba import prange, types
-from numba.core.caching import FunctionCache
 from numba.extending import intrinsic
 
-from .._jit import core, inline, kernel, parallel
+from .._jit import SharedCache, core, inline, kernel, parallel
 
 CHUNKS_PER_THREAD = 32
 MIN_CHUNK = 64  # states: each worker allocates a workspace, so chunks of a small batch stay large
@@ -79,7 +78,7 @@ def claim(counter, B, nchunk):
     return c * B // nchunk, min(c + 1, nchunk) * B // nchunk
 
 
-class ClosureCache(FunctionCache):
+class ClosureCache(SharedCache):
     """Numba's on-disk cache for a function that closes over other compiled functions.
 
     Numba keys a cached function by its source file and the pickled values of its closure
