@@ -210,3 +210,38 @@ def test_workspace_views_share_the_buffer_and_never_overrun_it():
     assert end == 14 and buf[11] == 7.0 and buf[13] == 5.0
     with pytest.raises(IndexError, match="workspace buffer too small"):
         _carve(3 * 4 + 1, 4)
+
+
+IMPORT_COMPILES_NOTHING = """
+import importlib, pkgutil, sys
+from numba.core.dispatcher import Dispatcher
+import robodyn, robodyn.simulation, robodyn.control
+from robodyn import _jit
+import robodyn.algorithms as algorithms
+for info in pkgutil.iter_modules(algorithms.__path__):
+    importlib.import_module("robodyn.algorithms." + info.name)
+mods = [m for name, m in list(sys.modules.items()) if name.startswith("robodyn")]
+kernels = [getattr(m, n) for m in mods for n in dir(m) if isinstance(getattr(m, n), (Dispatcher, _jit._FirstCall))]
+compiled = sorted({repr(k) for k in kernels if isinstance(k, Dispatcher) and k.signatures})
+waiting = sum(isinstance(k, _jit._FirstCall) for k in kernels)
+from robodyn.algorithms import rnea
+rd = robodyn
+model = rd.models.load("double_pendulum")
+rd.rnea(model, [0.1, 0.2], [0.0, 0.0], [0.0, 0.0])
+print(len(kernels), compiled, waiting, type(rnea._rnea_packed).__name__)
+"""
+
+
+def test_importing_compiles_nothing_and_the_first_call_compiles_its_fast_path(tmp_path):
+    """Importing every module of the package compiles no kernel (the single-state fast paths
+    wait for their first call); after ``rnea``'s first call its fast path is the compiled
+    dispatcher itself in its module."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    out = subprocess.run([sys.executable, "-c", IMPORT_COMPILES_NOTHING], env=env, capture_output=True, text=True,
+                         check=True).stdout.split(maxsplit=1)[1]
+    assert out.startswith("[] ") and out.split()[-1] == "CPUDispatcher", out
+    assert int(out.split()[-2]) >= 6  # rnea, aba, crba, coriolis, both derivatives, the coupled ones

@@ -21,10 +21,12 @@ caller happens to compile a function first.
 ``fast(*argtypes)``: a single-state entry point compiled for exactly one argument signature
 (C-contiguous float64 arrays ``VEC``/``MAT`` for the state and the output, the model's
 ``MODEL_INTS``/``MODEL_PACKED`` arrays (writeable: see ``layout.KernelTables``), a ``bool``).
-Compilation happens (or the cache is loaded) when the module defining it is imported, and the
-dispatcher compiles nothing else: any other argument types (lists, integers, strided or
-read-only arrays, batches) raise ``TypeError``, on which the public function takes its general
-path.
+Compilation happens (or the cache is loaded) at its first call, not when its module is
+imported (importing ``robodyn.simulation`` would otherwise compile the single-state ABA, RNEA,
+CRBA, ... that a simulation may never call); the compiled dispatcher then replaces the
+placeholder in its module, so that later calls pay nothing for the laziness. It compiles
+nothing else: any other argument types (lists, integers, strided or read-only arrays,
+batches) raise ``TypeError``, on which the public function takes its general path.
 
 Every kind is cached on disk through :class:`SharedCache`: Numba's cache, with saves locked
 between processes, so that processes compiling at once into one cache (``robodyn warmup`` on
@@ -40,6 +42,7 @@ finiteness checks stay exact.
 import contextlib
 import itertools
 import os
+import sys
 import threading
 
 from numba import njit
@@ -133,17 +136,15 @@ INTS = _types.Array(_types.int64, 1, "C")
 
 
 def fast(*argtypes):
-    """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only."""
-    def decorate(func):
-        dispatcher = kernel(func)
-        dispatcher.compile(_types.int64(*argtypes))
-        dispatcher.disable_compile()
-        return dispatcher
-    return decorate
+    """Decorator: a kernel returning an int64 status, compiled for ``argtypes`` only, at its
+    first call (a :class:`_FirstCall` until then)."""
+    signature = _types.int64(*argtypes)
+    return lambda func: _FirstCall(func, signature)
 
 
 class _FirstCall:
-    """A :func:`fast` kernel compiled at its first call (see :func:`fast_lazy`)."""
+    """A :func:`fast` kernel before its first call: compiles it then (once, whichever thread
+    calls first) and puts the dispatcher in its place in the defining module."""
 
     __slots__ = ("dispatcher", "signature", "ready", "_lock", "__wrapped__")
 
@@ -158,15 +159,13 @@ class _FirstCall:
         return self.dispatcher(*args)
 
     def compile(self):
-        """Compile the one signature (once, whichever thread calls first)."""
-        with self._lock:  # a second thread waits here, then finds it ready
+        """Compile the one signature (a second thread waits here, then finds it ready)."""
+        with self._lock:
             if not self.ready:
                 self.dispatcher.compile(self.signature)
-                self.dispatcher.disable_compile()  # other types raise TypeError, as fast()'s
+                self.dispatcher.disable_compile()  # other types raise TypeError
                 self.ready = True
-
-
-def fast_lazy(*argtypes):
-    """Decorator: :func:`fast`, compiled (or loaded from the disk cache) at the first call."""
-    signature = _types.int64(*argtypes)
-    return lambda func: _FirstCall(func, signature)
+                module = sys.modules.get(self.__wrapped__.__module__)
+                name = self.__wrapped__.__name__
+                if getattr(module, name, None) is self:
+                    setattr(module, name, self.dispatcher)  # the module's later calls go straight to it

@@ -216,8 +216,7 @@ def coupled_call(model, one, batch, sizes, third: str, q, v, x, f_ext, frame: st
     if f_ext is None and frame in WRENCH_FRAMES:
         res = fast_out(out, (model.nv,))
         try:  # one state of contiguous float64 vectors (the dispatcher raises TypeError otherwise)
-            run = one.dispatcher if one.ready else one  # compiled: the dispatcher itself
-            if run(k.ints, packed, tables.ints, tables.floats, q, v, x, NO_WRENCHES, NO_WRENCH, check, res) == OK:
+            if one(k.ints, packed, tables.ints, tables.floats, q, v, x, NO_WRENCHES, NO_WRENCH, check, res) == OK:
                 return res
         except TypeError:
             pass

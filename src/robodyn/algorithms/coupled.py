@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean, int64
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast_lazy, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast, inline, kernel
 from ..coupling import expand_q, expand_v, reduce_force, reduce_matrix
 from ..coupling_kernels import expand_positions, expand_velocity, reduce_square, reduce_vector
 from ..joint_kernels import nq_of
@@ -91,7 +91,7 @@ def aba_coupled_at(args, s, ws):
 _aba_coupled_batch = batch_kernel(aba_coupled_at, aba_workspace)
 
 
-@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
+@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
 def _aba_coupled_one(ints, packed, cints, cfloats, q, v, tau, fext, fcode, check, qdd):
     """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
     body, dofs, params, _ = unpack(ints, packed)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, fast_lazy, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..joint_kernels import nq_of
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
@@ -172,7 +172,7 @@ def crba_coupled_at(args, s, ws):
 _crba_coupled_batch = batch_kernel(crba_coupled_at, coupled_workspace)
 
 
-@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, boolean, MAT)
+@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, boolean, MAT)
 def _crba_coupled_one(ints, packed, cints, cfloats, q, check, M):
     """One state of a coupled model."""
     body, dofs, _, _ = unpack(ints, packed)

@@ -20,7 +20,7 @@ import numpy as np
 from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, fast_lazy, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import body_placement, nq_of, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
@@ -249,7 +249,7 @@ def rnea_coupled_at(args, s, ws):
 _rnea_coupled_batch = batch_kernel(rnea_coupled_at, coupled_workspace)
 
 
-@fast_lazy(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
+@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
 def _rnea_coupled_one(ints, packed, cints, cfloats, q, v, a, fext, fcode, check, tau):
     """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
     body, dofs, params, _ = unpack(ints, packed)
