@@ -11,6 +11,7 @@ under ``JointPD``) and ``coupled_rollout`` (the same with a mimic coupling), in 
     python benchmarks/cold_start.py            # all of it (a few minutes)
     python benchmarks/cold_start.py rnea aba   # only these algorithms, no warmup
     python benchmarks/cold_start.py rollout    # the first contact rollout alone
+    python benchmarks/cold_start.py warmup-processes   # everything, one compiling process per core
 """
 
 import os
@@ -65,6 +66,10 @@ for name in which:
         continue
     if name == "warmup":
         timed("rd.warmup() (everything else)", rd.warmup)
+        continue
+    if name == "warmup-processes":  # one compiling process per core
+        import os
+        timed(f"rd.warmup(processes={os.cpu_count()})", lambda: rd.warmup(processes=os.cpu_count()))
         continue
     timed(name + ", one state", lambda: getattr(rd, name)(model, *args[name]))
     timed(name + ", batch of 4", lambda: getattr(rd, name)(model, *batch[name]))

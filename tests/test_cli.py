@@ -181,9 +181,11 @@ def test_warmup_compiles_every_step_and_draws_a_bar_on_a_terminal(capsys, monkey
     assert err == ""  # not a terminal: no bar
     monkeypatch.setattr(_warmup, "steps", lambda: [("a", lambda: None), ("b", lambda: None)])
     monkeypatch.setattr(sys.stderr, "isatty", lambda: True)
-    code, out, err = run(capsys, "warmup")
+    code, out, err = run(capsys, "warmup", "--processes", "1")  # (the stand-in steps are this process's)
     assert code == 0 and "2 steps" in out
     assert "[" + "#" * 30 + "] 100%" in err
+    code, out, err = run(capsys, "warmup", "--processes", "0")
+    assert code == 2 and "--processes 0: expected a number of processes >= 1" in err
 
 
 def test_demo_says_when_rnea_adds_friction_and_armature(capsys):

@@ -167,7 +167,7 @@ def _coupled_steps(rd, model):
     return out
 
 
-def warmup(progress=None, only=None) -> None:
+def warmup(progress=None, only=None, processes: int = 1) -> None:
     """Compile or load every kernel: each public algorithm (single and batched calls, fixed and
     floating base) and the simulation kernels.
 
@@ -175,7 +175,14 @@ def warmup(progress=None, only=None) -> None:
     each step and once at the end (``name`` empty), e.g. to draw a progress bar.
     ``only``: None (everything), or the names of the functions to compile (``["rnea",
     "aba"]``: their steps alone, e.g. on the workers of a cluster that run only those).
+    ``processes``: how many processes compile at once (a first run on a machine of several
+    cores): when the first step needed compiling, each process takes the next group of the
+    other steps (a function's, or one simulation with contacts, the longest first) and
+    compiles it into the shared on-disk cache, ``progress`` called as groups start and end;
+    then this process loads everything (a few seconds). 1, or a filled cache: all here.
     """
+    if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)) or processes < 1:
+        raise ValueError(f"processes: expected an integer >= 1, got {processes!r}")
     todo = steps()
     if only is not None:
         only = {only} if isinstance(only, str) else set(only)
@@ -183,9 +190,121 @@ def warmup(progress=None, only=None) -> None:
         if unknown:
             raise ValueError(f"only: no warm-up step for {sorted(unknown)}")
         todo = [(name, call) for name, call in todo if name.split(" ")[0] in only]
+    n, report = len(todo), progress
     for k, (name, call) in enumerate(todo):
-        if progress is not None:
-            progress(k, len(todo), name)
-        call()
+        if report is not None:
+            report(k, n, name)
+        if k == 0 and processes > 1 and n > 1 and _compiles(call):
+            # a first run: the helpers the first step shares with the others are compiled now
+            _compile_in_processes([name for name, _ in todo[1:]], int(processes), progress, 1, n)
+            report = None  # the rest is loaded from the cache
+        elif k > 0 or processes == 1 or n == 1:
+            call()
     if progress is not None:
-        progress(len(todo), len(todo), "")
+        progress(n, n, "")
+
+
+def _compiles(call) -> bool:
+    """Runs ``call``; whether Numba compiled anything for it (else the cache had it all, and
+    most likely the rest too: a filled cache is loaded faster here than by new processes)."""
+    from numba.core import event
+
+    with event.install_recorder("numba:compile") as compiled:
+        call()
+    return bool(compiled.buffer)
+
+
+def _groups(names: list[str]) -> list[list[str]]:
+    """The steps in groups that one process compiles: a function's steps together (they share
+    its kernels), each simulation with contacts alone (the longest compilations), those first."""
+    groups: dict[str, list[str]] = {}
+    for name in names:
+        key = name if "contacts" in name else name.split(" (")[0]
+        groups.setdefault(key, []).append(name)
+    return sorted(groups.values(), key=lambda g: "contacts" not in g[0])  # stable: the rest in order
+
+
+SERVE = "from robodyn._warmup import _serve; _serve()"
+
+
+def _serve() -> None:
+    """A compiling process of :func:`_compile_in_processes`: runs each group of steps named on
+    a line of stdin (JSON), then prints ``done``; stops at the end of stdin."""
+    import json
+    import sys
+
+    calls = dict(steps())
+    for line in sys.stdin:
+        for name in json.loads(line):
+            calls[name]()
+        print("done", flush=True)
+
+
+def _compile_in_processes(names: list[str], processes: int, progress, done: int = 0, total: int | None = None):
+    """Compile the steps ``names`` in ``processes`` child processes (see :func:`warmup`), each
+    handed the next group when it has finished one, ``progress(done, total, name)`` as a group
+    starts (``done`` counting from the given, of ``total`` steps, default ``len(names)``);
+    raises if one of them fails (what the others compiled stays in the cache)."""
+    import json
+    import queue
+    import subprocess
+    import sys
+    import tempfile
+    import threading
+
+    todo, total = _groups(names), len(names) if total is None else total
+    events: queue.Queue = queue.Queue()
+    children, running, finished = {}, {}, False
+    for _ in range(min(processes, len(todo))):
+        err = tempfile.TemporaryFile("w+")
+        child = subprocess.Popen([sys.executable, "-c", SERVE], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                 stderr=err, text=True)
+        children[child] = err
+        threading.Thread(target=_relay, args=(child, events), daemon=True).start()
+
+    def hand_out(child):
+        if todo:
+            running[child] = todo.pop(0)
+            if progress is not None:
+                progress(done, total, running[child][0])
+            child.stdin.write(json.dumps(running[child]) + "\n")
+            child.stdin.flush()
+        else:
+            running.pop(child, None)
+            child.stdin.close()  # the child ends
+
+    try:
+        for child in children:
+            hand_out(child)
+        while running:
+            child, line = events.get()
+            if child not in running:  # a child without work, ending
+                continue
+            if line is None:  # the child ended before its group was done
+                raise RuntimeError(f"warmup: the process compiling {running[child][0]!r} stopped (exit code "
+                                   f"{child.wait()}): {_tail(children[child])}")
+            done += len(running[child])
+            hand_out(child)
+        finished = True
+    finally:
+        for child, err in children.items():
+            if not finished:
+                child.kill()
+            child.wait()
+            if not child.stdin.closed:
+                child.stdin.close()
+            err.close()
+
+
+def _relay(child, events) -> None:
+    """Puts ``(child, line)`` for each line the child prints, then ``(child, None)``."""
+    with child.stdout:
+        for line in child.stdout:
+            events.put((child, line))
+    events.put((child, None))
+
+
+def _tail(err, lines: int = 5) -> str:
+    """The last ``lines`` lines a child wrote to its stderr file."""
+    err.seek(0)
+    return " | ".join(err.read().strip().splitlines()[-lines:]) or "no message"

@@ -3,6 +3,7 @@ its dynamics at a sample state, timings, and compiling every kernel ahead of tim
 
 from __future__ import annotations
 
+import os
 import sys
 
 import numpy as np
@@ -130,7 +131,10 @@ def cmd_warmup(args) -> int:
         bar.update(done)
         count[0] = total
 
-    warmup(progress)
+    processes = (os.cpu_count() or 1) if args.processes is None else args.processes
+    if processes < 1:
+        raise ValueError(f"--processes {processes}: expected a number of processes >= 1")
+    warmup(progress, processes=processes)
     bar.close()
     print(f"robodyn warmup: {count[0]} steps compiled or loaded from the cache in "
           f"{time.perf_counter() - start:.1f} s")
@@ -153,4 +157,6 @@ def add_commands(sub) -> None:
     p.add_argument("--no-compare", action="store_true", help="do not run Pinocchio even if installed")
     p.set_defaults(func=cmd_bench)
     p = sub.add_parser("warmup", help="compile (or load from the cache) every kernel now, with a progress bar")
+    p.add_argument("--processes", type=int, default=None,
+                   help="processes compiling at once on a first run (default: one per core)")
     p.set_defaults(func=cmd_warmup)
