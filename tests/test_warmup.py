@@ -65,9 +65,10 @@ def test_compiling_in_processes_then_loading_here(monkeypatch):
     assert [done for done, _, _ in seen] == sorted(done for done, _, _ in seen)
 
 
-def test_processes_start_only_when_the_first_step_compiles(monkeypatch):
-    """A filled cache is loaded here (new processes would take longer); a step that compiles
-    (a function Numba does not cache) starts them."""
+def test_processes_start_at_the_first_step_that_compiles(monkeypatch):
+    """Steps whose code this process or the cache has run here (new processes would take
+    longer); from the first that compiles (a function Numba does not cache), the steps after
+    it go to the processes."""
     import numba
 
     started = []
@@ -76,9 +77,11 @@ def test_processes_start_only_when_the_first_step_compiles(monkeypatch):
     rd.warmup(only=["rnea"], processes=2)
     assert started == []
     fresh = numba.njit(lambda x: x + 1)
-    monkeypatch.setattr(W, "steps", lambda: [("new", lambda: fresh(1)), ("old", lambda: None)])
+    ran = []
+    monkeypatch.setattr(W, "steps", lambda: [("old", lambda: ran.append("old")), ("new", lambda: ran.append(fresh(1))),
+                                             ("next", lambda: ran.append("next")), ("last", lambda: ran.append("last"))])
     rd.warmup(processes=2)
-    assert started == [["old"]]
+    assert started == [["next", "last"]] and ran == ["old", 2, "next", "last"]
 
 
 def test_a_failing_compiling_process_is_an_error_naming_its_step():

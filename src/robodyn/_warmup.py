@@ -176,10 +176,11 @@ def warmup(progress=None, only=None, processes: int = 1) -> None:
     ``only``: None (everything), or the names of the functions to compile (``["rnea",
     "aba"]``: their steps alone, e.g. on the workers of a cluster that run only those).
     ``processes``: how many processes compile at once (a first run on a machine of several
-    cores): when the first step needed compiling, each process takes the next group of the
-    other steps (a function's, or one simulation with contacts, the longest first) and
-    compiles it into the shared on-disk cache, ``progress`` called as groups start and end;
-    then this process loads everything (a few seconds). 1, or a filled cache: all here.
+    cores): the steps run here while the cache has their code; from the first that needed
+    compiling (the helpers it shares with the others compiled with it), each process takes
+    the next group of the steps after it (a function's, or one simulation with contacts, the
+    longest first) and compiles it into the shared on-disk cache, ``progress`` called as
+    groups start; then this process loads them (a few seconds). 1: all here.
     """
     if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)) or processes < 1:
         raise ValueError(f"processes: expected an integer >= 1, got {processes!r}")
@@ -190,23 +191,22 @@ def warmup(progress=None, only=None, processes: int = 1) -> None:
         if unknown:
             raise ValueError(f"only: no warm-up step for {sorted(unknown)}")
         todo = [(name, call) for name, call in todo if name.split(" ")[0] in only]
-    n, report = len(todo), progress
+    n, report, watch = len(todo), progress, processes > 1
     for k, (name, call) in enumerate(todo):
         if report is not None:
             report(k, n, name)
-        if k == 0 and processes > 1 and n > 1 and _compiles(call):
-            # a first run: the helpers the first step shares with the others are compiled now
-            _compile_in_processes([name for name, _ in todo[1:]], int(processes), progress, 1, n)
-            report = None  # the rest is loaded from the cache
-        elif k > 0 or processes == 1 or n == 1:
+        if not watch:
             call()
+        elif _compiles(call) and k + 1 < n:  # not in the cache: a first run, the others in processes
+            _compile_in_processes([name for name, _ in todo[k + 1:]], int(processes), progress, k + 1, n)
+            report = watch = None  # the rest is loaded from the cache
     if progress is not None:
         progress(n, n, "")
 
 
 def _compiles(call) -> bool:
-    """Runs ``call``; whether Numba compiled anything for it (else the cache had it all, and
-    most likely the rest too: a filled cache is loaded faster here than by new processes)."""
+    """Runs ``call``; whether Numba compiled anything for it (else this process or the cache
+    had it all: a filled cache is loaded faster here than by new processes)."""
     from numba.core import event
 
     with event.install_recorder("numba:compile") as compiled:
