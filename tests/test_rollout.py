@@ -40,6 +40,27 @@ def test_each_rollout_is_the_simulation_from_its_state():
     assert np.count_nonzero(R.contact_force[..., 2]) > 100
 
 
+def test_a_contact_simulation_in_pieces_is_the_simulation_in_one(capfd):
+    """With the progress bar, a simulation with contacts runs in pieces of about 1 % (the
+    rollouts' worker, one piece per call): the controller's time and the solver's warm start
+    carry over, to the last bit."""
+    from robodyn.contact import Sphere
+    from robodyn.control import ComputedTorque, quintic
+
+    model = rd.models.load("panda")
+    q0 = np.array([0.0, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8])
+    q1 = q0 + 0.2 * (np.arange(7) == 1)  # the hand pressed down into the table and dragged
+    height = rd.frame_pose(model, q0, "link7")[2, 3] - 0.06
+    hand = Contacts([Sphere("link7", 0.05)], surfaces=[Plane(height=height, friction=0.5)])  # touching at once
+    law = ComputedTorque(model, quintic(q0, q1, 0.2, t0=0.05), 100.0, 20.0)
+    one = rd.simulate(model, q0, np.zeros(7), 0.3, 1e-3, law, contacts=hand)
+    pieces = rd.simulate(model, q0, np.zeros(7), 0.3, 1e-3, law, contacts=hand, progress=True)
+    assert "100%" in capfd.readouterr().err
+    for key in ("q", "v", "a", "tau", "contact_force", "solver_residual", "solver_iterations"):
+        np.testing.assert_array_equal(getattr(pieces, key), getattr(one, key), err_msg=key)
+    assert np.count_nonzero(one.contact_force[:, 0, 2]) > 150 and np.abs(one.contact_force[:, 0, :2]).max() > 100
+
+
 def test_every_keeps_the_named_samples():
     q0, v0 = box_states(3, seed=1)
     full = rd.rollout(BOX, q0, v0, 0.3, 1e-3, contacts=BOX_CONTACTS)

@@ -1,5 +1,9 @@
-"""Compiled runs of the contact time stepping under a compiled control law: one simulation
-(:func:`run`, ``simulate``) and the parallel rollouts (:func:`rollout_at`, ``rollout``).
+"""Compiled runs of the contact time stepping under a compiled control law: the rollouts of a
+batch (``rollout``) and the pieces of one simulation (``simulate``), both by one compiled
+worker (:data:`batch` for a tree, :data:`coupled_batch` for a coupled model) whose state is
+:func:`rollout_at`: Numba optimises and emits the whole contact step once per compiled
+function that contains it, so one worker for both halves what a first ``simulate`` and
+``rollout`` compile.
 
 A run steps ``(q, v)`` with :func:`._contact_step.step`, the command from the law
 (``control.laws.law_torque``) at each step. A model with mimic couplings
@@ -16,9 +20,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._jit import inline, kernel, splice
+from ..algorithms.driver import threaded_batch_kernel
 from ..algorithms.status import OK
 from ..contact.solver import INFO_SIZE
-from ..control.laws import law_sizes, law_torque, law_workspace
+from ..control.laws import law_torque, law_workspace
 from . import _contact_step as CK
 from . import _coupled_contact_step as CCK
 
@@ -27,10 +32,10 @@ from . import _coupled_contact_step as CCK
 def run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq):
     """Scratch of :func:`run_steps` for a tree: the step's, the control law's (a model of
     ``law_nb`` bodies, its tree of sizes ``law_nq``, ``law_nv``), the command, the next state,
-    the warm start, and (unused) the coupled runs' reduced state and step workspace."""
+    and (unused) the coupled runs' reduced state and step workspace."""
     none = np.empty(0)
     return (CK.workspace(nb, nv, npairs), law_workspace(law_nb, nv, law_nq, law_nv), np.empty(nv), np.empty(nq),
-            np.empty(nv), np.zeros((npairs, 3)), (none, none, none), none)
+            np.empty(nv), (none, none, none), none)
 
 
 @kernel
@@ -39,8 +44,7 @@ def coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr):
     (coordinates) on a tree of ``nv`` (``nq``): as :func:`run_workspace`, with the coupled
     step's workspace and the independent state and command."""
     return (CK.workspace(0, 0, 0), law_workspace(law_nb, nr, law_nq, law_nv), np.empty(nv), np.empty(nq),
-            np.empty(nv), np.zeros((npairs, 3)), (np.empty(nqr), np.empty(nr), np.empty(nr)),
-            CCK.workspace(nb, nv, nr, npairs))
+            np.empty(nv), (np.empty(nqr), np.empty(nr), np.empty(nr)), CCK.workspace(nb, nv, nr, npairs))
 
 
 @inline
@@ -48,14 +52,14 @@ def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, break
               radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, cmap, cscale, independent,
               independent_q):
     """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
-    ``simulate._run_compiled``), writing ``Q[1:], V[1:]`` and, for every sample but the last
+    ``simulate._run_contacts``), writing ``Q[1:], V[1:]`` and, for every sample but the last
     unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
     solver ``info``; ``warm`` (npairs, 3) the impulses of the step before. ``rws``:
     :func:`run_workspace` (or :func:`coupled_run_workspace` with the coupling, see the module
     docstring). Returns ``(status, sample)`` of the first failure (``(OK, -1)``)."""
     ws, law_ws, cmd, qn, vn = rws[0], rws[1], rws[2], rws[3], rws[4]
-    qr, vr, cmdr = rws[6]
-    cws = rws[7]
+    qr, vr, cmdr = rws[5]
+    cws = rws[6]
     n = Q.shape[0] - 1
     for s in range(n + 1 if final else n):
         q, v, t = Q[s], V[s], (s0 + s) * dt
@@ -85,30 +89,6 @@ def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, break
             for k in range(vn.shape[0]):
                 V[s + 1, k] = vn[k]
     return OK, -1
-
-
-@kernel
-def run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers, radii,
-        surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm):
-    """:func:`run_steps` of one simulation of a tree."""
-    law_nb, law_nq, law_nv = law_sizes(c)
-    rws = run_workspace(ints.shape[0], V.shape[1], D.shape[1], law_nb, law_nq, law_nv, Q.shape[1])
-    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
-                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, None, None,
-                     None, None)
-
-
-@kernel
-def coupled_run(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
-                radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, cmap, cscale, independent,
-                independent_q):
-    """:func:`run_steps` of one simulation of a coupled model (see the module docstring)."""
-    law_nb, law_nq, law_nv = law_sizes(c)
-    rws = coupled_run_workspace(ints.shape[0], V.shape[1], independent.shape[0], D.shape[1], law_nb, law_nq, law_nv,
-                                Q.shape[1], independent_q.shape[0])
-    return run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
-                     centers, radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, cmap, cscale,
-                     independent, independent_q)
 
 
 @kernel
@@ -148,40 +128,52 @@ def keep(Qs, Vs, As, Ts, Fs, Ds, Is, j, A, T, Fc, D, info, k):
 
 @splice
 def rollout_at(args, b, rws):
-    """Rollout ``b`` of a batch (``rollout._batch``) from its first sample, keeping every
-    ``every``-th sample (segments of ``every`` steps in the workspace); its failing step into
-    ``failed[b]``. ``bodies`` (B or 1, nb, BODY_COLUMNS): the body table of each rollout
-    (its inertial parameters), or one for all; the last four arguments the coupling (None for
-    a tree, see the module docstring)."""
+    """Rollout ``b`` of a batch (``rollout``) from its first sample, keeping every ``every``-th
+    sample (segments of ``every`` steps in the workspace), or with ``every`` 0 one piece of a
+    simulation (``simulate._run_contacts``): every sample straight into ``Q[b]``, ... from
+    step ``s0``, the last sample stepped too when ``final``. ``warm[b]`` (npairs, 3): the
+    impulses of the step before the first (zero for a rollout), then of the last step. The
+    failing step into ``failed[b]`` (a rollout's step number; a piece's sample). ``bodies``
+    (B or 1, nb, BODY_COLUMNS): the body table of each rollout (its inertial parameters), or
+    one for all; the last four arguments the coupling (None for a tree, see the module
+    docstring)."""
     (ints, bodies, dofs, params, fext, fcode, limit, c0, c1, c2, c3, c4, c5, c6, c7, law, gains, breaks, coefs,
-     tau_cmd, points, centers, radii, surf, settings, dt, every, Q, V, A, T, Fc, D, info, failed, cmap, cscale,
-     independent, independent_q) = args
+     tau_cmd, points, centers, radii, surf, settings, dt, every, s0, final, Q, V, A, T, Fc, D, info, warm_all, failed,
+     cmap, cscale, independent, independent_q) = args
     c = (c0, c1, c2, c3, c4, c5, c6, c7)  # the law's model, flat in ``args``
     body = bodies[b if bodies.shape[0] > 1 else 0]
-    warm = rws[5]
-    Qs, Vs, As, Ts, Fs, Ds, Is = rws[8]
-    for p in range(warm.shape[0]):
-        for r in range(3):
-            warm[p, r] = 0.0
+    warm = warm_all[b]
+    Qs, Vs, As, Ts, Fs, Ds, Is = rws[7]
     kept = Q.shape[1]
-    for k in range(kept):
-        last = k == kept - 1
-        for r in range(Qs.shape[1]):
-            Qs[0, r] = Q[b, k, r]
-        for r in range(Vs.shape[1]):
-            Vs[0, r] = V[b, k, r]
-        m = 1 if last else every + 1
-        st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
-                          centers, radii, surf, settings, k * every, dt, last, Qs[:m], Vs[:m], As[:m], Ts[:m],
-                          Fs[:m], Ds[:m], Is[:m], warm, rws, cmap, cscale, independent, independent_q)
-        if st != OK:
-            failed[b] = k * every + s
-            return st
-        keep(Qs, Vs, As, Ts, Fs, Ds, Is, 0, A[b], T[b], Fc[b], D[b], info[b], k)
-        if not last:
+    pieces = 1 if every == 0 else kept
+    for k in range(pieces):
+        last = k == pieces - 1
+        if every == 0:  # straight into the outputs
+            Qk, Vk, Ak, Tk, Fk, Dk, Ik, start, fin = Q[b], V[b], A[b], T[b], Fc[b], D[b], info[b], s0, final
+        else:
             for r in range(Qs.shape[1]):
-                Q[b, k + 1, r] = Qs[every, r]
+                Qs[0, r] = Q[b, k, r]
             for r in range(Vs.shape[1]):
-                V[b, k + 1, r] = Vs[every, r]
+                Vs[0, r] = V[b, k, r]
+            m = 1 if last else every + 1
+            Qk, Vk, Ak, Tk, Fk, Dk, Ik = Qs[:m], Vs[:m], As[:m], Ts[:m], Fs[:m], Ds[:m], Is[:m]
+            start, fin = s0 + k * every, last
+        st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
+                          centers, radii, surf, settings, start, dt, fin, Qk, Vk, Ak, Tk, Fk, Dk, Ik, warm, rws, cmap,
+                          cscale, independent, independent_q)
+        if st != OK:
+            failed[b] = s if every == 0 else k * every + s
+            return st
+        if every != 0:
+            keep(Qs, Vs, As, Ts, Fs, Ds, Is, 0, A[b], T[b], Fc[b], D[b], info[b], k)
+            if not last:
+                for r in range(Qs.shape[1]):
+                    Q[b, k + 1, r] = Qs[every, r]
+                for r in range(Vs.shape[1]):
+                    V[b, k + 1, r] = Vs[every, r]
     failed[b] = -1
     return OK
+
+
+batch = threaded_batch_kernel(rollout_at, rollout_workspace)
+coupled_batch = threaded_batch_kernel(rollout_at, coupled_rollout_workspace)

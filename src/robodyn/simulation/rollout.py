@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._deprecated import renamed_keyword
-from ..algorithms.driver import chunks, threaded_batch_kernel
+from ..algorithms.driver import chunks
 from ..algorithms.status import NO_WRENCH, OK
 from ..contact import solver as CS
 from ..errors import RobodynWarning
@@ -31,10 +31,6 @@ from ..coupling import expand_q, expand_v, is_coupled, joint_tree
 from . import _contact_runs as CR
 from .coupled import run_coupling
 from .simulate import law_arrays, compiled_law, positive_number, raise_at, unit_configuration
-
-_batch = threaded_batch_kernel(CR.rollout_at, CR.rollout_workspace)
-_coupled_batch = threaded_batch_kernel(CR.rollout_at, CR.coupled_rollout_workspace)
-
 
 @dataclass(frozen=True)
 class Rollouts:
@@ -155,12 +151,12 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     args = (k.ints, bodies, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
             np.ascontiguousarray(tree.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
-            Q, V, A, T, Fc, D, info, failed, *coupling)
+            0, True, Q, V, A, T, Fc, D, info, np.zeros((B, npairs, 3)), failed, *coupling)
     if is_coupled(model):
-        _coupled_batch(args, (model.nbodies, tree.nv, model.nv, npairs, *law_sizes, tree.nq, model.nq, int(every)),
-                       status, chunks(B))
+        CR.coupled_batch(args, (model.nbodies, tree.nv, model.nv, npairs, *law_sizes, tree.nq, model.nq, int(every)),
+                         status, chunks(B))
     else:
-        _batch(args, (model.nbodies, model.nv, npairs, *law_sizes, model.nq, int(every)), status, chunks(B))
+        CR.batch(args, (model.nbodies, model.nv, npairs, *law_sizes, model.nq, int(every)), status, chunks(B))
     bad = np.flatnonzero(status != OK)
     if bad.size:
         b = int(bad[0])

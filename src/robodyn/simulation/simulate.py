@@ -488,20 +488,27 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
     warm = np.zeros((len(names), 3))
     geometry = (points, centers, radii, surf, settings)
     Q[0], V[0] = q0, v0
-    if compiled is not None:
+    if compiled is not None:  # the rollouts' worker, on the pieces of this one run (``every`` 0)
         c, code, gains, breaks, coefs = law_arrays(model, compiled)
-        zero = np.zeros(nv)
+        ints, body, *rest = plant.args
+        fixed = (ints, body[None], *rest, *c, code, gains, breaks, coefs, np.zeros(nv), *geometry, dt, 0)
+        coupling_args = (None,) * 4 if coupling is None else coupled.run_coupling(coupling)
+        law_tree = joint_tree(model if compiled[0] == CONSTANT else compiled[1])  # the law's model
+        law_sizes = (law_tree.nbodies, law_tree.nq, law_tree.nv)
+        if coupling is None:
+            run, sizes = CR.batch, (model.nbodies, nv, len(names), *law_sizes, model.nq, 0)
+        else:  # the law in the independent coordinates
+            run, sizes = CR.coupled_batch, (model.nbodies, nv, coupling.nv, len(names), *law_sizes, model.nq,
+                                            coupling.nq, 0)
+        status, failed = np.zeros(1, np.int64), np.zeros(1, np.int64)
         piece = max(1, n // 100) if bar.enabled else n
-        run, extra = CR.run, ()
-        if coupling is not None:  # the law in the independent coordinates
-            run, extra = CR.coupled_run, coupled.run_coupling(coupling)
         for a in range(0, n, piece):
             b = min(n, a + piece)
-            status, s = run(*plant.args, c, code, gains, breaks, coefs, zero, *geometry, a, dt, b == n, Q[a:b + 1],
-                            V[a:b + 1], A[a:b + 1], T[a:b + 1], touch.force[a:b + 1], touch.geometry[a:b + 1],
-                            touch.info[a:b + 1], warm, *extra)
-            if status != OK:
-                raise_at(model, status, t[a + s], Q[a + s], V[a + s], T[a + s], coupling is not None)
+            run((*fixed, a, b == n, *(x[None, a:b + 1] for x in (Q, V, A, T, touch.force, touch.geometry, touch.info)),
+                 warm[None], failed, *coupling_args), sizes, status, 1)
+            if status[0] != OK:
+                s = int(failed[0])
+                raise_at(model, int(status[0]), t[a + s], Q[a + s], V[a + s], T[a + s], coupling is not None)
             bar.update(b)
     else:
         step, ws, extra = CK.step_kernel, CK.workspace(model.nbodies, nv, len(names)), ()
