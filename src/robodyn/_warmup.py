@@ -278,7 +278,7 @@ def _compile_in_processes(names: list[str], processes: int, progress, done: int 
             hand_out(child)
         while running:
             child, line = events.get()
-            if child not in running:  # a child without work, ending
+            if child not in running or line not in (None, "done\n"):  # a child without work, ending; other output
                 continue
             if line is None:  # the child ended before its group was done
                 raise RuntimeError(f"warmup: the process compiling {running[child][0]!r} stopped (exit code "
