@@ -201,15 +201,15 @@ def _read_tree(source, visuals: bool = False):
 class GeomVisual(NamedTuple):
     """One drawable ``<geom>`` of an MJCF file: ``link`` the body it belongs to (``"world"``
     for the ``<worldbody>``'s own), ``index`` its geom number in MuJoCo's model (``mjModel``'s
-    geom id: every geom in body order), ``name`` its name or ``<link>_<k>`` (k: its place among
-    the link's drawn geoms; ``_1``, ``_2``, ... appended to a name the file uses), ``kind`` one of ``sphere``,
-    ``capsule``, ``cylinder``, ``box``, ``ellipsoid``, ``mesh``, ``size`` as the viewer takes
-    it (``(radius,)``; ``(radius, length)`` along z, a capsule's between its sphere centres; a
-    box's three edges; an ellipsoid's semi-axes; ``()`` for a mesh), ``filename`` the mesh
-    file (None for the others), ``R`` (3, 3), ``p`` (3,) the geom frame in the link frame,
-    ``scale`` (3,) the mesh's, ``rgba`` (4,) the colour MuJoCo draws or None (neither an rgba
-    nor a material: MuJoCo's grey 0.5 0.5 0.5 1, the viewer's default), ``where`` file and
-    line."""
+    geom id: every geom in body order), ``name`` its name or ``<link>_<k>`` (k: its place
+    among the link's drawn geoms; ``_1``, ``_2``, ... appended to a name the file uses),
+    ``kind`` one of ``sphere``, ``capsule``, ``cylinder``, ``box``, ``ellipsoid``, ``mesh``,
+    ``size`` as the viewer takes it (``(radius,)``; ``(radius, length)`` along z, a capsule's
+    between its sphere centres; a box's three edges; an ellipsoid's semi-axes; ``()`` for a
+    mesh), ``filename`` the mesh file (None for the others), ``R`` (3, 3), ``p`` (3,) the geom
+    frame in the link frame, ``scale`` (3,) the mesh's, ``rgba`` (4,) the colour MuJoCo draws
+    or None (neither an rgba nor a material: MuJoCo's grey 0.5 0.5 0.5 1, the viewer's
+    default), ``where`` file and line."""
     link: str
     index: int
     name: str

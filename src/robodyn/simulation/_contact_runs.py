@@ -23,6 +23,7 @@ from .._jit import inline, kernel, splice
 from ..algorithms.driver import threaded_batch_kernel
 from ..algorithms.status import OK
 from ..contact.solver import INFO_SIZE
+from ..coupling import joint_tree
 from ..control.laws import law_torque, law_workspace
 from . import _contact_step as CK
 from . import _coupled_contact_step as CCK
@@ -177,3 +178,15 @@ def rollout_at(args, b, rws):
 
 batch = threaded_batch_kernel(rollout_at, rollout_workspace)
 coupled_batch = threaded_batch_kernel(rollout_at, coupled_rollout_workspace)
+
+
+def run_batch(args, tree, coupled, law_model, npairs: int, every: int, status, nchunk: int) -> None:
+    """:data:`batch` (``coupled`` None) or :data:`coupled_batch` (``coupled`` the
+    :class:`~robodyn.coupling.CoupledModel` on ``tree``) on ``args`` (see :func:`rollout_at`),
+    the workspace sized for ``tree``, the control law's model ``law_model`` and ``npairs``."""
+    law = joint_tree(law_model)
+    per_law = (npairs, law.nbodies, law.nq, law.nv)
+    if coupled is None:
+        batch(args, (tree.nbodies, tree.nv, *per_law, tree.nq, every), status, nchunk)
+    else:
+        coupled_batch(args, (tree.nbodies, tree.nv, coupled.nv, *per_law, tree.nq, coupled.nq, every), status, nchunk)

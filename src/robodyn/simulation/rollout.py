@@ -145,18 +145,12 @@ def rollout(model, q0, v0, duration: float, dt: float, controller=None, *, conta
     failed, status = np.zeros(B, np.int64), np.zeros(B, np.int64)
     k = tree.kernel
     c, law, gains, breaks, coefs = law_arrays(model, compiled)
-    law_tree = joint_tree(cmodel)
-    law_sizes = (law_tree.nbodies, law_tree.nq, law_tree.nv)
     coupling = run_coupling(model) if is_coupled(model) else (None,) * 4
     args = (k.ints, bodies, k.dofs[True, True], k.params[True], k.zero_wrench, NO_WRENCH,
             np.ascontiguousarray(tree.effort_limit),
             *c, law, gains, breaks, coefs, np.zeros(model.nv), points, centers, radii, surf, settings, dt, int(every),
             0, True, Q, V, A, T, Fc, D, info, np.zeros((B, npairs, 3)), failed, *coupling)
-    if is_coupled(model):
-        CR.coupled_batch(args, (model.nbodies, tree.nv, model.nv, npairs, *law_sizes, tree.nq, model.nq, int(every)),
-                         status, chunks(B))
-    else:
-        CR.batch(args, (model.nbodies, model.nv, npairs, *law_sizes, model.nq, int(every)), status, chunks(B))
+    CR.run_batch(args, tree, model if is_coupled(model) else None, cmodel, npairs, int(every), status, chunks(B))
     bad = np.flatnonzero(status != OK)
     if bad.size:
         b = int(bad[0])

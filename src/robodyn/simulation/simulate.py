@@ -493,19 +493,14 @@ def _run_contacts(plant, compiled, law, contacts, q0, v0, dt, t, Q, V, Z, A, T, 
         ints, body, *rest = plant.args
         fixed = (ints, body[None], *rest, *c, code, gains, breaks, coefs, np.zeros(nv), *geometry, dt, 0)
         coupling_args = (None,) * 4 if coupling is None else coupled.run_coupling(coupling)
-        law_tree = joint_tree(model if compiled[0] == CONSTANT else compiled[1])  # the law's model
-        law_sizes = (law_tree.nbodies, law_tree.nq, law_tree.nv)
-        if coupling is None:
-            run, sizes = CR.batch, (model.nbodies, nv, len(names), *law_sizes, model.nq, 0)
-        else:  # the law in the independent coordinates
-            run, sizes = CR.coupled_batch, (model.nbodies, nv, coupling.nv, len(names), *law_sizes, model.nq,
-                                            coupling.nq, 0)
+        law_model = model if compiled[0] == CONSTANT else compiled[1]  # (with a coupling: its coordinates)
         status, failed = np.zeros(1, np.int64), np.zeros(1, np.int64)
         piece = max(1, n // 100) if bar.enabled else n
         for a in range(0, n, piece):
             b = min(n, a + piece)
-            run((*fixed, a, b == n, *(x[None, a:b + 1] for x in (Q, V, A, T, touch.force, touch.geometry, touch.info)),
-                 warm[None], failed, *coupling_args), sizes, status, 1)
+            pieces = (x[None, a:b + 1] for x in (Q, V, A, T, touch.force, touch.geometry, touch.info))
+            CR.run_batch((*fixed, a, b == n, *pieces, warm[None], failed, *coupling_args), model, coupling, law_model,
+                         len(names), 0, status, 1)
             if status[0] != OK:
                 s = int(failed[0])
                 raise_at(model, int(status[0]), t[a + s], Q[a + s], V[a + s], T[a + s], coupling is not None)

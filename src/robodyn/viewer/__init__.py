@@ -25,5 +25,5 @@ from .offscreen import render, render_video
 from .scene import Part, Playback, parts, playback
 from .server import Viewer, show
 
-__all__ = ["show", "render", "render_video", "visuals", "mjcf_visuals", "visual_poses", "skeleton", "VisualShape", "Camera",
-           "Viewer", "Mesh", "Part", "Playback", "parts", "playback", "resolve_mesh", "shape_mesh"]
+__all__ = ["show", "render", "render_video", "visuals", "mjcf_visuals", "visual_poses", "skeleton", "VisualShape",
+           "Camera", "Viewer", "Mesh", "Part", "Playback", "parts", "playback", "resolve_mesh", "shape_mesh"]
