@@ -66,8 +66,8 @@ def test_every_kernel_kind_uses_the_shared_cache():
     from robodyn.algorithms.driver import claim
     from robodyn.simulation import _contact_runs
 
-    for dispatcher in (rnea._rnea_batch, rnea.rnea_state, rnea.motion_step, aba._aba_packed, claim,
-                       _contact_runs.rollout_at, _contact_runs.run_workspace):
+    for dispatcher in (rnea._rnea_batch.loop, rnea._rnea_batch.run_range, rnea.rnea_state, rnea.motion_step,
+                       aba._aba_packed, claim, _contact_runs.rollout_at, _contact_runs.run_workspace):
         assert isinstance(dispatcher._cache, SharedCache), dispatcher
 
 

@@ -8,8 +8,9 @@ import sys
 
 import numpy as np
 import pytest
+from numba.core.caching import NullCache
 
-from robodyn._jit import inline, kernel
+from robodyn._jit import inline, kernel, splice
 from robodyn.algorithms import driver
 from robodyn.algorithms.driver import batch_kernel, chunks, threaded_batch_kernel
 
@@ -34,9 +35,10 @@ def _offset_workspace(n):
     return ws
 
 
-@inline
+@splice
 def _shifted_views(args, ws):
-    """A ``views`` that hands the state function a different workspace."""
+    """A ``views`` that hands the state function a different workspace (spliced into its
+    caller: a compiled function without reference counting returns no array, see ``_jit``)."""
     return ws[1:]
 
 
@@ -66,6 +68,35 @@ def test_more_chunks_than_states_and_views():
     _shifted_batch((X, Y), (3,), status, 64)
     assert (status == 0).all()
     np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+
+
+def test_the_loop_calls_the_chunks_at_their_address_and_holds_no_copy():
+    """``run_range`` is compiled once for the arguments' types and the parallel loop calls it
+    at its address: the loop's code holds no copy of it (a direct call would link it into the
+    loop's module, to be optimised and emitted again there)."""
+    fresh = batch_kernel(_affine_at, _offset_workspace)
+    fresh.loop._cache = NullCache()  # compiled here (the code of a cached loop is not shown)
+    X = np.arange(6.0).reshape(3, 2)
+    Y, status = np.empty_like(X), np.empty(3, np.int64)
+    fresh((X, Y), (2,), status, chunks(3))
+    np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+    names = [c.fndesc.llvm_func_name for c in fresh.run_range.overloads.values()]
+    code = "".join(fresh.loop.inspect_llvm().values())
+    assert len(names) == 1 and "call_chunk" not in code and names[0] not in code
+
+
+def test_each_argument_type_gets_its_own_compiled_chunks():
+    """Arguments of another type (a Fortran-ordered input) compile ``run_range`` again, and
+    each call runs the code compiled for its own types."""
+    fresh = batch_kernel(_affine_at, _offset_workspace)
+    X = np.arange(12.0).reshape(6, 2)
+    wide = np.zeros((6, 4))
+    wide[:, ::2] = X
+    for x in (X, np.asfortranarray(X), X, wide[:, ::2]):
+        Y, status = np.empty((6, 2)), np.empty(6, np.int64)
+        fresh((x, Y), (2,), status, chunks(6))
+        np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
+    assert len(fresh.run_range.overloads) == 3  # C, F and A (every other column) layouts
 
 
 class _CountedThread(driver.threading.Thread):
@@ -128,8 +159,8 @@ def test_an_exception_in_a_threaded_worker_reaches_the_caller(monkeypatch):
 
 KEY = """
 from robodyn.algorithms import rnea, crba
-for k in (rnea._rnea_batch, crba._crba_batch):
-    print(k._cache._index_key(("sig",), k.targetctx.codegen()))
+for b in (rnea._rnea_batch, crba._crba_batch):
+    print("|".join(str(k._cache._index_key(("sig",), k.targetctx.codegen())) for k in (b.loop, b.run_range)))
 """
 
 
@@ -141,8 +172,8 @@ def test_cache_keys_are_stable_across_processes_and_differ_per_algorithm():
     runs = [subprocess.run([sys.executable, "-c", KEY], capture_output=True, text=True, check=True, env=env).stdout
             for _ in range(2)]
     assert runs[0] == runs[1]
-    rnea_key, crba_key = runs[0].strip().split("\n")
-    assert rnea_key != crba_key
+    rnea_keys, crba_keys = (line.split("|") for line in runs[0].strip().split("\n"))
+    assert rnea_keys[0] != crba_keys[0] and rnea_keys[1] != crba_keys[1]  # the loops and the chunks
 
 
 def test_no_parallel_loop_outside_the_driver():

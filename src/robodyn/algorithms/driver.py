@@ -21,6 +21,8 @@ done, its later ones find none left. On a shared machine one core often runs slo
 other for a while (another process, the hypervisor); with one fixed share of the batch per
 thread, the fast thread would wait for the slow one, with claimed chunks it takes more of the
 batch. Which worker computes a state never changes its result: every state is computed alone.
+A chunk is computed by one compiled function called at its address (:class:`BatchKernel`),
+so that the per-state code is compiled once, not once more inside each piece of the loop.
 
 A batch whose one state is a whole simulation (``rollout``) uses :func:`threaded_batch_kernel`
 instead: the same workers and chunks, on Python threads (see there for why).
@@ -40,7 +42,9 @@ import threading
 import numba
 import numpy as np
 from llvmlite import ir
-from numba import prange, types
+from numba import prange, typeof, types
+from numba._dispatcher import compute_fingerprint
+from numba.core import cgutils
 from numba.extending import intrinsic
 
 from .._jit import SharedCache, core, inline, kernel, parallel
@@ -111,7 +115,7 @@ def _cached(dispatcher):
 
 def batch_kernel(state_at, workspace, views=None):
     """The parallel batch kernel ``batch(args, sizes, status, nchunk)`` of an algorithm whose
-    one state is ``state_at(args, s, ws)`` (see the module docstring)."""
+    one state is ``state_at(args, s, ws)`` (see the module docstring): a :class:`BatchKernel`."""
 
     if views is None:
         def run_range(args, status, lo, hi, ws):
@@ -123,18 +127,79 @@ def batch_kernel(state_at, workspace, views=None):
             for s in range(lo, hi):
                 status[s] = state_at(args, s, ws)
 
-    run_range = _cached(core(run_range))
-
-    def batch(args, sizes, status, nchunk):
+    def loop(address, args, sizes, status, nchunk):
         B, counter = status.shape[0], np.zeros(1, np.int64)
         for _ in prange(nchunk):
             ws = workspace(*sizes)
             lo, hi = claim(counter, B, nchunk)
             while lo < hi:
-                run_range(args, status, lo, hi, ws)
+                call_chunk(address, args, status, lo, hi, ws)
                 lo, hi = claim(counter, B, nchunk)
 
-    return _cached(parallel(batch))
+    return BatchKernel(_cached(core(run_range)), workspace, _cached(parallel(loop)))
+
+
+class BatchKernel:
+    """``batch(args, sizes, status, nchunk)``: the parallel ``loop`` over the chunks of a batch,
+    each chunk computed by ``run_range(args, status, lo, hi, ws)``, called at its machine-code
+    address (:func:`call_chunk`).
+
+    Why by address: Numba copies the code of every compiled function a kernel calls into the
+    kernel and optimises and emits it again there, and a parallel loop is several functions
+    (the loop body, two gufunc wrappers, the kernel): an algorithm's whole per-state code was
+    compiled four or five times for its batch kernel. Called by address, it is compiled once
+    (``run_range`` for the arguments' types) and the loop alone is small (the ABA's batch
+    kernel compiles in a third of the time, at the same speed: the call is once per chunk).
+    ``run_range`` is compiled for each new combination of argument types (the key: Numba's
+    fingerprint of the arguments, as its own dispatch uses), the workspace's type from
+    ``workspace`` compiled for ``sizes``; both are cached on disk like every kernel."""
+
+    def __init__(self, run_range, workspace, loop):
+        self.run_range, self.workspace, self.loop = run_range, workspace, loop
+        self._addresses: dict = {}
+        self._lock = threading.Lock()
+
+    def __call__(self, args, sizes, status, nchunk):
+        try:
+            key = compute_fingerprint((args, sizes, status))
+        except NotImplementedError:  # a value Numba's fast path does not type: its full type
+            key = typeof((args, sizes, status))
+        address = self._addresses.get(key)
+        if address is None:
+            address = self._compile(key, args, sizes, status)
+        self.loop(address, args, sizes, status, nchunk)
+
+    def _compile(self, key, args, sizes, status) -> int:
+        """Compiles (or loads) ``run_range`` for these arguments; its address."""
+        with self._lock:
+            if key not in self._addresses:
+                shapes = tuple(typeof(sizes))
+                self.workspace.compile(shapes)
+                ws = self.workspace.overloads[shapes].signature.return_type
+                signature = types.none(typeof(args), typeof(status), types.int64, types.int64, ws)
+                self.run_range.compile(signature)
+                compiled = self.run_range.overloads[signature.args]
+                self._addresses[key] = compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
+            return self._addresses[key]
+
+
+@intrinsic
+def call_chunk(typingctx, address, args, status, lo, hi, ws):
+    """Calls the compiled ``run_range(args, status, lo, hi, ws)`` at machine-code ``address``
+    (Numba's calling convention; see :class:`BatchKernel`, which compiled it for exactly these
+    types); an exception it raises is returned to the caller as from a direct call."""
+    if not (isinstance(address, types.Integer) and lo == types.int64 and hi == types.int64):
+        return None
+    argtypes = (args, status, lo, hi, ws)
+
+    def codegen(context, builder, signature, llargs):
+        callee = builder.inttoptr(llargs[0], context.call_conv.get_function_type(types.none, argtypes).as_pointer())
+        returned, _ = context.call_conv.call_function(builder, callee, types.none, argtypes, llargs[1:])
+        with cgutils.if_unlikely(builder, returned.is_error):
+            context.call_conv.return_status_propagate(builder, returned)
+        return context.get_dummy_value()
+
+    return types.none(address, *argtypes), codegen
 
 
 def threaded_batch_kernel(state_at, workspace):
