@@ -258,3 +258,58 @@ def test_a_massless_model_with_contacts_is_named():
                 rd.simulate(m, q0, np.zeros(m.nv), 0.01, 1e-3, controller, contacts=contacts, progress=False)
         with pytest.raises(ValueError, match=f"rollout 0: simulate at t = 0: the {where}.*positive definite"):
             rd.rollout(m, q0[None], np.zeros(m.nv), 0.01, 1e-3, contacts=contacts)
+
+
+def test_the_coupled_kernels_compile_no_tree_step():
+    """The coupling arguments choose the step when a kernel compiles: Numba prunes ``cmap is
+    None`` for a tree, not for an array, so the coupled kernels cut the tree's step by
+    ``tree_marker``'s None (``_contact_runs.run_steps``' pattern, here with two helpers that
+    record being compiled)."""
+    from numba import njit
+
+    from robodyn.simulation._contact_runs import tree_marker
+
+    @njit
+    def tree_only(x):
+        return x + 1.0
+
+    @njit
+    def coupled_only(x, cmap):
+        return x + cmap[0]
+
+    @njit
+    def run(x, cmap):
+        tree = tree_marker(cmap)
+        return steps(x, cmap, tree)
+
+    @njit
+    def steps(x, cmap, tree):
+        if cmap is None:
+            if tree is None:
+                return 0.0
+            return tree_only(x)
+        return coupled_only(x, cmap)
+
+    assert run(1.0, np.array([5.0])) == 6.0
+    assert (len(tree_only.signatures), len(coupled_only.signatures)) == (0, 1)  # the coupled kernel
+    assert run(1.0, None) == 2.0
+    assert (len(tree_only.signatures), len(coupled_only.signatures)) == (1, 1)  # and the tree's
+
+
+def test_without_the_marker_numba_compiles_both_steps():
+    """The control of the test above: with the test on ``cmap`` alone, the coupled call
+    compiles the tree's helper too."""
+    from numba import njit
+
+    @njit
+    def tree_only(x):
+        return x + 1.0
+
+    @njit
+    def steps(x, cmap):
+        if cmap is None:
+            return tree_only(x)
+        return x + cmap[0]
+
+    assert steps(1.0, np.array([5.0])) == 6.0
+    assert len(tree_only.signatures) == 1  # compiled though never run

@@ -11,13 +11,17 @@ A run steps ``(q, v)`` with :func:`._contact_step.step`, the command from the la
 :func:`._coupled_contact_step.step`: its law sees the independent coordinates
 ``(q[independent_q], v[independent])`` and commands their forces, zero on the mimic dofs. The
 coupling arguments ``cmap, cscale, independent, independent_q`` are None for a tree: Numba
-then prunes the coupled branch at compile time (a test of an argument that is None); the
-coupled kernels type both branches (the tree's step gets an empty workspace, never run).
+then prunes the coupled branch at compile time (a test of an argument that is None). It
+prunes nothing on ``cmap is None`` for an array, so for a coupled model the tree's step is
+cut by a second argument, :func:`tree_marker`'s None (the coupled worker compiled the tree's
+whole contact step otherwise).
 """
 
 from __future__ import annotations
 
 import numpy as np
+from numba import types
+from numba.extending import overload
 
 from .._jit import inline, kernel, splice
 from ..algorithms.driver import threaded_batch_kernel
@@ -48,16 +52,30 @@ def coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr):
             np.empty(nv), (np.empty(nqr), np.empty(nr), np.empty(nr)), CCK.workspace(nb, nv, nr, npairs))
 
 
+def tree_marker(cmap):
+    """0 for a tree (``cmap`` None), None for a coupled model: an argument whose test ``is
+    None`` Numba prunes in the coupled kernels (see the module docstring)."""
+    return 0 if cmap is None else None
+
+
+@overload(tree_marker)
+def _tree_marker_by_type(cmap):
+    if isinstance(cmap, types.NoneType):
+        return lambda cmap: 0
+    return lambda cmap: None
+
+
 @inline
 def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points, centers,
               radii, surf, settings, s0, dt, final, Q, V, A, T, Fc, D, info, warm, rws, cmap, cscale, independent,
-              independent_q):
+              independent_q, tree):
     """Steps from ``(Q[0], V[0])`` at time ``s0 dt`` under a compiled control law (see
     ``simulate._run_contacts``), writing ``Q[1:], V[1:]`` and, for every sample but the last
     unless ``final``, the step's ``A``, ``T``, contact forces ``Fc``, distances ``D`` and
     solver ``info``; ``warm`` (npairs, 3) the impulses of the step before. ``rws``:
     :func:`run_workspace` (or :func:`coupled_run_workspace` with the coupling, see the module
-    docstring). Returns ``(status, sample)`` of the first failure (``(OK, -1)``)."""
+    docstring; ``tree``: :func:`tree_marker`). Returns ``(status, sample)`` of the first
+    failure (``(OK, -1)``)."""
     ws, law_ws, cmd, qn, vn = rws[0], rws[1], rws[2], rws[3], rws[4]
     qr, vr, cmdr = rws[5]
     cws = rws[6]
@@ -65,6 +83,8 @@ def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, break
     for s in range(n + 1 if final else n):
         q, v, t = Q[s], V[s], (s0 + s) * dt
         if cmap is None:
+            if tree is None:  # never: a coupled model's kernel, where this cuts the tree's step
+                return OK, -1
             st = law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, law_ws, cmd)
             if st == OK:
                 st = CK.step(ints, body, dofs, params, fext, fcode, limit, points, centers, radii, surf, settings, q,
@@ -161,7 +181,7 @@ def rollout_at(args, b, rws):
             start, fin = s0 + k * every, last
         st, s = run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, breaks, coefs, tau_cmd, points,
                           centers, radii, surf, settings, start, dt, fin, Qk, Vk, Ak, Tk, Fk, Dk, Ik, warm, rws, cmap,
-                          cscale, independent, independent_q)
+                          cscale, independent, independent_q, tree_marker(cmap))
         if st != OK:
             failed[b] = s if every == 0 else k * every + s
             return st
