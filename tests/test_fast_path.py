@@ -245,3 +245,12 @@ def test_importing_compiles_nothing_and_the_first_call_compiles_its_fast_path(tm
                          check=True).stdout.split(maxsplit=1)[1]
     assert out.startswith("[] ") and out.split()[-1] == "CPUDispatcher", out
     assert int(out.split()[-2]) >= 6  # rnea, aba, crba, coriolis, both derivatives, the coupled ones
+
+
+def test_a_compiled_helper_refuses_calls_from_python():
+    """``inline`` helpers are compiled without the wrappers that Python calls go through (only
+    compiled code calls them): a call from Python is a ``TypeError`` naming the helper."""
+    from robodyn.algorithms.aba import pivot
+
+    with pytest.raises(TypeError, match="pivot is a compiled helper"):
+        pivot(np.eye(6), 0, 6, 0, 6, 1e-12)

@@ -105,19 +105,37 @@ class SharedCache(FunctionCache):
                                         source_stamp=self._impl.locator.get_source_stamp())
 
 
-def _jit(**options):
-    """``njit(**options)`` whose dispatchers save to and load from a :class:`SharedCache`."""
+def _jit(compiled_callers_only=False, **options):
+    """``njit(**options)`` whose dispatchers save to and load from a :class:`SharedCache`;
+    ``compiled_callers_only``: a helper that only compiled code calls, compiled without the
+    wrappers that let Python and C call it (a call from Python raises ``TypeError``)."""
     def decorate(func):
-        dispatcher = njit(**options)(func)
+        if compiled_callers_only:
+            dispatcher = njit(no_cpython_wrapper=True, no_cfunc_wrapper=True, **options)(func)
+            dispatcher.__class__ = _helper_class(type(dispatcher))
+        else:
+            dispatcher = njit(**options)(func)
         dispatcher._cache = SharedCache(dispatcher.py_func)
         return dispatcher
     return decorate
 
 
+_HELPER_CLASSES: dict = {}
+
+
+def _helper_class(base):
+    """``base`` (Numba's dispatcher class) whose instances refuse calls from Python."""
+    if base not in _HELPER_CLASSES:
+        def __call__(self, *args, **kwargs):
+            raise TypeError(f"{self.py_func.__qualname__} is a compiled helper: only compiled code calls it")
+        _HELPER_CLASSES[base] = type("CompiledHelper", (base,), {"__call__": __call__})
+    return _HELPER_CLASSES[base]
+
+
 kernel = _jit(**_CALLED)
 parallel = _jit(parallel=True, **_CALLED)
 core = _jit(_nrt=False, **_CALLED)
-inline = _jit(_nrt=False, **dict(_BASE, forceinline=True))
+inline = _jit(True, _nrt=False, **dict(_BASE, forceinline=True))
 # ``splice``: a tiny helper called with many argument types (a workspace's shapes), spliced
 # into each caller's Numba IR (``inline="always"``): cheaper to compile than one machine-code
 # function per argument type. Also a large function with one caller (``rollout_at``): a
@@ -125,7 +143,7 @@ inline = _jit(_nrt=False, **dict(_BASE, forceinline=True))
 splice = _jit(_nrt=False, inline="always", **_CALLED)
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
 # carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.
-exact = _jit(_nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
+exact = _jit(True, _nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
 
 
 VEC = _types.Array(_types.float64, 1, "C")
