@@ -178,8 +178,8 @@ def warmup(progress=None, only=None, processes: int = 1) -> None:
     ``processes``: how many processes compile at once (a first run on a machine of several
     cores): the steps run here while the cache has their code; from the first that needed
     compiling (the helpers it shares with the others compiled with it), each process takes
-    the next group of the steps after it (a function's, or one simulation with contacts, the
-    longest first) and compiles it into the shared on-disk cache, ``progress`` called as
+    the next group of the steps after it (a function's, or the simulations with contacts,
+    the longest, first) and compiles it into the shared on-disk cache, ``progress`` called as
     groups start; then this process loads them (a few seconds). 1: all here.
     """
     if isinstance(processes, bool) or not isinstance(processes, (int, np.integer)) or processes < 1:
@@ -216,10 +216,12 @@ def _compiles(call) -> bool:
 
 def _groups(names: list[str]) -> list[list[str]]:
     """The steps in groups that one process compiles: a function's steps together (they share
-    its kernels), each simulation with contacts alone (the longest compilations), those first."""
+    its kernels), the simulations with contacts together and first (the longest compilation;
+    the tree's and the coupled model's share the contact solver and the dynamics terms, which
+    two processes would compile at once)."""
     groups: dict[str, list[str]] = {}
     for name in names:
-        key = name if "contacts" in name else name.split(" (")[0]
+        key = "contacts" if "contacts" in name else name.split(" (")[0]
         groups.setdefault(key, []).append(name)
     return sorted(groups.values(), key=lambda g: "contacts" not in g[0])  # stable: the rest in order
 

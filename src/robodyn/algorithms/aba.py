@@ -35,7 +35,7 @@ import numpy as np
 from numba import boolean
 
 from .._deprecated import renamed_keyword
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, splice
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import local_placement, nq_of, passive_torque
 from ..joints import FREE
@@ -512,10 +512,11 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
     return hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws)
 
 
-@core
+@splice
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
-    known acceleration (``ws[18]`` is all False; ``ws[17]`` receives the copy of ``tau``).
+    known acceleration (``ws[18]`` is all False; ``ws[17]`` receives the copy of ``tau``);
+    spliced into its callers, which so call (and copy) the compiled ``hybrid_one`` alone.
     Returns a status (see ``_inputs``): ``i + 1`` when the articulated inertia of body ``i``
     is singular."""
     return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[18], fext, fcode, check, qdd, ws[17], ws)
