@@ -133,6 +133,9 @@ def _helper_class(base):
 
 
 kernel = _jit(**_CALLED)
+# ``scratch``: a ``kernel`` that allocates a workspace for compiled callers only (no wrappers:
+# boxing its tuple of arrays for Python would be most of its code; a Python call is a TypeError).
+scratch = _jit(True, **_CALLED)
 parallel = _jit(parallel=True, **_CALLED)
 core = _jit(_nrt=False, **_CALLED)
 inline = _jit(True, _nrt=False, **dict(_BASE, forceinline=True))

@@ -4,8 +4,8 @@
 with compiled code once on a small model, single state and batch, fixed and floating base,
 then a short simulation of each kind (uncontrolled, compiled controllers, Python controllers).
 Compiled code is cached on disk, so after the first process this only loads it (about a
-second); on a fresh install the first process compiles everything (about two minutes, see
-``benchmarks/RESULTS.md``).
+second); on a fresh install the first process compiles everything (about four minutes on
+one core, two on two with ``processes=2``; see ``benchmarks/RESULTS.md``).
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ import numpy as np
 from numba import boolean
 
 from .._deprecated import renamed_keyword
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, splice
+from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch, splice
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import local_placement, nq_of, passive_torque
 from ..joints import FREE
@@ -80,7 +80,7 @@ def workspace_views(buf, nb, nv):
     return (P, vel, c, IA, pA, acc, U, Dinv, u, UD, G, d, S, Ia, t1, t2, tau)
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
     Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy

@@ -24,7 +24,7 @@ import numpy as np
 from numba import boolean
 
 from .._deprecated import renamed_keyword
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
 from ..coupling import is_coupled
 from . import coupled
 from ._lazy import any_lazy, deferred
@@ -38,7 +38,7 @@ from .status import (NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, finite2, rais
                      result_status)
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`derivatives_one`: the workspaces of the RNEA, its derivatives and
     ``M^-1``, then ``(qdd, h, dtau_dq, dtau_dv, an empty M)``."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline, kernel, scratch
 from ..layout import IV, NDOF, PARENT
 from ..coupling import expand_q, is_coupled, reduce_columns
 from ._lazy import any_lazy, deferred
@@ -24,7 +24,7 @@ from .kinematics import poses_checked, world_motion_subspace
 from .driver import batch_kernel, chunks
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
             np.empty((3, 3)), np.empty(3), np.empty((nv, 6)), np.empty((nb, 10)))

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
 from ..joint_kernels import nq_of
 from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
@@ -39,7 +39,7 @@ from .status import OK, WRONG_SIZE, finite2, result_status
 from .driver import batch_kernel, chunks
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`coriolis_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, oSd, Ic, Bc, oV, K,
     Vx, F1, F2, F3, h)``."""

@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean, int64
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast, inline, scratch
 from ..coupling import expand_q, expand_v, reduce_force, reduce_matrix
 from ..coupling_kernels import expand_positions, expand_velocity, reduce_square, reduce_vector
 from ..joint_kernels import nq_of
@@ -38,7 +38,7 @@ from .status import (NONFINITE, NOT_POSITIVE_DEFINITE, OK, WRONG_SIZE, finite, r
                      result_status)
 
 
-@kernel
+@scratch
 def aba_workspace(nb, nqf, nvf, nv):
     """Scratch of :func:`aba_coupled_state`: the CRBA's, the RNEA's, and a buffer for the full
     tree's ``q, v, 0, h, M`` and the reduced ``M`` (nq_full + 3 nv_full + nv_full^2 + nv^2)."""

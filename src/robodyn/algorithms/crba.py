@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
 from ..joint_kernels import nq_of
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
@@ -43,7 +43,7 @@ def workspace_views(buf, nb, nv):
     return (P, oS, Ic, F)
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
     buf = np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6)
@@ -135,7 +135,7 @@ def _crba_packed(ints, packed, q, check, M):
     return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
 
 
-@kernel
+@scratch
 def coupled_workspace(nb, nqf, nvf):
     """Scratch of :func:`crba_coupled_state`: the CRBA's, and a buffer for the full tree's
     ``q`` and ``M`` (nq_full + nv_full^2)."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import inline, kernel
+from .._jit import inline, kernel, scratch
 from ..layout import IQ, IV, JTYPE, MOTION, NDOF, PARENT, UNIT_AXIS
 from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
@@ -90,7 +90,7 @@ def poses_checked(ints, body, q, v, check, liR, lip, Rj, pj, oR, op):
     return result_status(check, finite2(op))
 
 
-@kernel
+@scratch
 def workspace(nb):
     return np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3)
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline, kernel, scratch
 from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_END
 from ..joint_kernels import local_placement, nq_of
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
@@ -50,7 +50,7 @@ from .aba import aligned_placement, articulated_inertia, joint_acceleration, joi
 from .driver import batch_kernel, chunks
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`minv_one`, carved from one buffer: ``(buffer, liR, lip, oR, op, d, Rj,
     IA, S, U, Dinv, F, UD, G, Ia, t1, t2)``; ``F[i, col]`` is column ``col`` of body ``i``'s

@@ -49,7 +49,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._deprecated import renamed_keywords
-from .._jit import core, inline, kernel
+from .._jit import core, inline, kernel, scratch
 from ..layout import IQ, IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
 from ..coupling import expand_q, expand_v, is_coupled, reduce_rows
@@ -66,7 +66,7 @@ EXTRA_COLUMNS = ("damping", "coulomb", "stiffness", "armature", "offset")
 EXTRA_FLAGS = PARAMS_SIZE
 
 
-@kernel
+@scratch
 def workspace(nb, nv):
     """Placements, world poses, motion, the unit parameter vectors and a 10 x 6 block."""
     return (np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((nb, 3, 3)), np.empty((nb, 3)),
@@ -167,7 +167,7 @@ def _regressor_single(ints, body, dofs, params, q, v, a, check, Y):
     return regressor_one(ints, body, dofs, params, q, v, a, check, Y, workspace(ints.shape[0], dofs.shape[0]))
 
 
-@kernel
+@scratch
 def reference_workspace(nb, nv):
     """:func:`workspace` plus the reference velocities (nb, 6) and two 6-vectors."""
     liR, lip, oR, op, Rj, pj, vel, acc, vJ, t1, t2, E, W, zero_v, zero_g = workspace(nb, nv)

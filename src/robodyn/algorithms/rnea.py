@@ -20,7 +20,7 @@ import numpy as np
 from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import body_placement, nq_of, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
@@ -51,14 +51,14 @@ def workspace_views(buf, nb):
     return (P, vel, acc, f, vJ, t1, t2)
 
 
-@kernel
+@scratch
 def workspace(nb):
     """Scratch of :func:`rnea_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2)``."""
     buf = np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18)
     return (buf,) + workspace_views(buf, nb)
 
 
-@kernel
+@scratch
 def motion_workspace(nb, nv):
     """Workspace of a velocity/acceleration pass at ``qdd = 0`` without gravity (used by the
     Jacobian derivative and the energies): placements, world poses, motion, zeros."""
@@ -208,7 +208,7 @@ def _rnea_packed(ints, packed, q, v, a, check, tau):
     return rnea_state(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
-@kernel
+@scratch
 def coupled_workspace(nb, nqf, nvf):
     """Scratch of :func:`rnea_coupled_state`: the RNEA's, and a buffer for the full tree's
     ``q, v, a, tau`` (nq_full + 3 nv_full)."""

@@ -59,7 +59,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline, kernel, scratch
 from ..spatial import force_act, inertia_act, inertia_matrix, motion_act
 from ..layout import (COULOMB, GRAVITY, INERTIA, INERTIA_END, IV, MOTION, NDOF, PARENT, SMOOTHING, STRIBECK,
                       STRIBECK_RATE)
@@ -199,7 +199,7 @@ def _state(tree, S, theta, oR, op, f, fcode, v, a, a0, out):
     _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, *_workspace(oR.shape[0], S.shape[0]))
 
 
-@kernel
+@scratch
 def _workspace(nb, nv):
     """The scratch arrays of :func:`_passes`, zeros: one per state of :func:`_state`, one per
     worker of the batch driver (which zeroes them again for every state: :func:`_state_at`)."""

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import inline, kernel
+from .._jit import inline, kernel, scratch
 from ..algorithms.jacobian import jacobian_one
 from ..algorithms.rnea import motion_workspace, rnea_coupled_state, rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
@@ -96,7 +96,7 @@ def law_rnea(c, dofs, q, v, a, ws, buf, out):
     return rnea_coupled_state(c[0], c[1], dofs, c[4], c[6], c[7], q, v, a, c[5], NO_WRENCH, CHECKED, out, (ws, buf))
 
 
-@kernel
+@scratch
 def law_workspace(nb, nv, nqf, nvf):
     """Scratch ``cws`` of :func:`law_torque` for a controller model of ``nb`` bodies and ``nv``
     dofs (``nqf``, ``nvf``: its tree's sizes, see :func:`law_sizes`): the RNEA's, the

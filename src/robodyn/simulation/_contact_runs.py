@@ -23,7 +23,7 @@ import numpy as np
 from numba import types
 from numba.extending import overload
 
-from .._jit import inline, kernel, splice
+from .._jit import inline, scratch, splice
 from ..algorithms.driver import threaded_batch_kernel
 from ..algorithms.status import OK
 from ..contact.solver import INFO_SIZE
@@ -33,7 +33,7 @@ from . import _contact_step as CK
 from . import _coupled_contact_step as CCK
 
 
-@kernel
+@scratch
 def run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq):
     """Scratch of :func:`run_steps` for a tree: the step's, the control law's (a model of
     ``law_nb`` bodies, its tree of sizes ``law_nq``, ``law_nv``), the command, the next state,
@@ -43,7 +43,7 @@ def run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq):
             np.empty(nv), (none, none, none), none)
 
 
-@kernel
+@scratch
 def coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr):
     """Scratch of :func:`run_steps` for a coupled model of ``nr`` (``nqr``) independent dofs
     (coordinates) on a tree of ``nv`` (``nq``): as :func:`run_workspace`, with the coupled
@@ -112,7 +112,7 @@ def run_steps(ints, body, dofs, params, fext, fcode, limit, c, law, gains, break
     return OK, -1
 
 
-@kernel
+@scratch
 def segments(nv, nq, npairs, every):
     """The ``every + 1`` samples of one segment of a rollout (see :func:`rollout_at`)."""
     m = every + 1
@@ -120,13 +120,13 @@ def segments(nv, nq, npairs, every):
             np.empty((m, npairs, 4)), np.empty((m, INFO_SIZE)))
 
 
-@kernel
+@scratch
 def rollout_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq, every):
     """Scratch of :func:`rollout_at` for a tree: :func:`run_workspace`'s and a segment's samples."""
     return run_workspace(nb, nv, npairs, law_nb, law_nq, law_nv, nq) + (segments(nv, nq, npairs, every),)
 
 
-@kernel
+@scratch
 def coupled_rollout_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr, every):
     """Scratch of :func:`rollout_at` for a coupled model (see :func:`coupled_run_workspace`)."""
     return coupled_run_workspace(nb, nv, nr, npairs, law_nb, law_nq, law_nv, nq, nqr) + (

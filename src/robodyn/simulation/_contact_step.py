@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline, kernel, scratch
 from ..algorithms.crba import crba_one
 from ..algorithms.crba import workspace as crba_workspace
 from ..algorithms.dense import backward, cholesky, forward
@@ -28,7 +28,7 @@ from ..layout import IV, JTYPE
 from ._kernels import chart_point, chart_rate
 
 
-@kernel
+@scratch
 def pair_workspace(npairs):
     """Scratch of :func:`contact_rows` and :func:`contact_velocity` for ``npairs`` pairs (none of
     it depends on the model): Delassus matrix, free contact velocities, targets, friction,
