@@ -10,6 +10,11 @@ of the inner loops). They must not allocate (workspaces come from their callers)
 by ``algorithms._workspace.view`` (which owns none), never an argument or a slice of one,
 since a caller that counts references would release it once too often.
 
+``inline`` (and ``exact``) helpers and the ``scratch`` workspace allocators are compiled
+without the CPython and C wrappers that a call from Python needs (only compiled code calls
+them; a Python call raises ``TypeError``): the wrappers unbox every argument and box the
+result, and were generated, optimised and emitted for nothing in every helper.
+
 ``inline`` functions are compiled once each, cached on disk like the others, and carry LLVM's
 ``alwaysinline`` attribute (Numba's ``forceinline``): LLVM copies them into every caller, so
 they cost no call, and compiling a kernel costs the sum of its helpers compiled once each

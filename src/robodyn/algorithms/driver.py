@@ -149,7 +149,7 @@ class BatchKernel:
     (the loop body, two gufunc wrappers, the kernel): an algorithm's whole per-state code was
     compiled four or five times for its batch kernel. Called by address, it is compiled once
     (``run_range`` for the arguments' types) and the loop alone is small (the ABA's batch
-    kernel compiles in a third of the time, at the same speed: the call is once per chunk).
+    kernel compiles in half the time, at the same speed: the call is once per chunk).
     ``run_range`` is compiled for each new combination of argument types (the key: Numba's
     fingerprint of the arguments, as its own dispatch uses), the workspace's type from
     ``workspace`` compiled for ``sizes``; both are cached on disk like every kernel."""
