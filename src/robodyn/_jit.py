@@ -140,10 +140,10 @@ def _helper_class(base):
 kernel = _jit(**_CALLED)
 # ``scratch``: a ``kernel`` that allocates a workspace for compiled callers only (no wrappers:
 # boxing its tuple of arrays for Python would be most of its code; a Python call is a TypeError).
-scratch = _jit(True, **_CALLED)
+scratch = _jit(compiled_callers_only=True, **_CALLED)
 parallel = _jit(parallel=True, **_CALLED)
 core = _jit(_nrt=False, **_CALLED)
-inline = _jit(True, _nrt=False, **dict(_BASE, forceinline=True))
+inline = _jit(compiled_callers_only=True, _nrt=False, **dict(_BASE, forceinline=True))
 # ``splice``: a tiny helper called with many argument types (a workspace's shapes), spliced
 # into each caller's Numba IR (``inline="always"``): cheaper to compile than one machine-code
 # function per argument type. Also a large function with one caller (``rollout_at``): a
@@ -151,7 +151,7 @@ inline = _jit(True, _nrt=False, **dict(_BASE, forceinline=True))
 splice = _jit(_nrt=False, inline="always", **_CALLED)
 # ``exact``: contraction (fused multiply-add) only, for code whose order of operations
 # carries its accuracy (``sincos``); inlined like ``inline``, its flags stay per operation.
-exact = _jit(True, _nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
+exact = _jit(compiled_callers_only=True, _nrt=False, **dict(_BASE, fastmath={"contract"}, forceinline=True))
 
 
 VEC = _types.Array(_types.float64, 1, "C")
