@@ -66,7 +66,7 @@ def test_batch():
 
 
 def test_general_path_equals_the_fast_path():
-    check_paths(rd.aba_derivatives, kernels._derivatives_packed)
+    check_paths(rd.aba_derivatives, kernels._derivatives_packed, kernels._derivatives_batch)
 
 
 @input_checks

@@ -137,7 +137,8 @@ def test_the_first_concurrent_calls_compile_once():
 
     def first_call(out):
         start.wait()
-        return fresh(k.ints, k.packed[False, False], tables.ints, tables.floats, q, False, out)
+        return fresh(crba._crba_coupled_batch.one_address, k.ints, k.packed[False, False], tables.ints, tables.floats,
+                     q, False, out)
 
     with ThreadPoolExecutor(4) as pool:
         statuses = list(pool.map(first_call, outs))

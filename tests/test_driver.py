@@ -10,8 +10,12 @@ import numpy as np
 import pytest
 from numba.core.caching import NullCache
 
-from robodyn._jit import inline, kernel, splice
+from numba import int64
+from numba.core.errors import TypingError
+
+from robodyn._jit import MAT, inline, kernel, splice
 from robodyn.algorithms import driver
+from robodyn.algorithms._workspace import row
 from robodyn.algorithms.driver import batch_kernel, chunks, threaded_batch_kernel
 
 SRC = pathlib.Path(__file__).resolve().parent.parent / "src" / "robodyn"
@@ -43,6 +47,14 @@ def _shifted_views(args, ws):
 
 
 _affine_batch = batch_kernel(_affine_at, _offset_workspace)
+_one_affine_batch = batch_kernel(_affine_at, _offset_workspace, one_state=((MAT, MAT), (int64,)))
+_call_one = _one_affine_batch.call_one
+
+
+@kernel
+def _affine_one(address, x, y):
+    """A single-state kernel: the batch's code at ``address`` for a batch of one."""
+    return _call_one(address, (row(x), row(y)), _offset_workspace(2))
 _shifted_batch = batch_kernel(_affine_at, _offset_workspace, _shifted_views)
 _threaded_batch = threaded_batch_kernel(_affine_at, _offset_workspace)
 
@@ -97,6 +109,47 @@ def test_each_argument_type_gets_its_own_compiled_chunks():
         fresh((x, Y), (2,), status, chunks(6))
         np.testing.assert_array_equal(Y, 2.0 * X + 1.0)
     assert len(fresh.run_range.overloads) == 3  # C, F and A (every other column) layouts
+
+
+def test_a_single_state_runs_the_batch_code_from_python_and_from_compiled_code():
+    """``serial`` (Python) and ``call_one`` (a compiled single-state kernel) run the batch's
+    compiled ``run_range`` for a batch of one: the single state's arrays with a leading axis
+    of one have the batch's types, so its code is compiled once for both."""
+    X = np.array([[1.0, 2.0], [3.0, 4.0], [-1.0, 0.0]])
+    Y, status = np.zeros((3, 2)), np.full(3, 9, np.int64)
+    _one_affine_batch((X, Y), (2,), status, chunks(3))
+    one_y, one_status = np.zeros((1, 2)), np.full(1, 9, np.int64)
+    _one_affine_batch.serial((X[:1], one_y), (2,), one_status)
+    y = np.zeros(2)
+    assert _affine_one(_one_affine_batch.one_address, X[1], y) == 0
+    np.testing.assert_array_equal(one_y[0], Y[0])
+    np.testing.assert_array_equal(y, Y[1])
+    assert one_status[0] == 0 and _affine_one(_one_affine_batch.one_address, X[2], y) == -1  # its status returned
+    assert len(_one_affine_batch.run_range.signatures) == 1
+
+
+_undeclared_call_one = batch_kernel(_affine_at, _offset_workspace).call_one
+
+
+@kernel
+def _wrong_one(address, x, y):
+    """A single-state kernel that passes ``x`` without its leading axis (not the declared types)."""
+    return _call_one(address, (x, row(y)), _offset_workspace(2))
+
+
+@kernel
+def _undeclared_one(address, x, y):
+    return _undeclared_call_one(address, (row(x), row(y)), _offset_workspace(2))
+
+
+def test_call_one_refuses_arguments_other_than_the_declared_types():
+    """The address is of code compiled for the declared ``one_state`` types: a single-state
+    kernel that builds others is a compile-time error naming both (never a call of machine
+    code with the wrong argument layout), as is one of a batch kernel that declares none."""
+    with pytest.raises(TypingError, match="not the declared one_state"):
+        _wrong_one(_one_affine_batch.one_address, np.zeros(2), np.zeros(2))
+    with pytest.raises(TypingError, match="declares no one_state"):
+        _undeclared_one(0, np.zeros(2), np.zeros(2))
 
 
 class _CountedThread(driver.threading.Thread):

@@ -254,3 +254,53 @@ def test_a_compiled_helper_refuses_calls_from_python():
 
     with pytest.raises(TypeError, match="pivot is a compiled helper"):
         pivot(np.eye(6), 0, 6, 0, 6, 1e-12)
+
+
+def _coupled(model):
+    """``model`` with its last one-dof joint mimicking its first (mimic couplings)."""
+    from robodyn.joints import NV
+
+    one = [name for name, t in zip(model.body_joint_names, model.joint_type) if NV[t] == 1]
+    return rd.CoupledModel(model, [(one[-1], one[0], 1.0, 0.0)])
+
+
+def _shared_code_cases():
+    from robodyn.algorithms import (aba, aba_derivatives, coriolis, coupled, crba, hybrid, kinematics, minv, rnea,
+                                    rnea_derivatives)
+
+    return {
+        "rnea": (rnea._rnea_batch, False, lambda m, q, v, a: rd.rnea(m, q, v, a)),
+        "aba": (aba._aba_batch, False, lambda m, q, v, a: rd.aba(m, q, v, a)),
+        "crba": (crba._crba_batch, False, lambda m, q, v, a: rd.crba(m, q)),
+        "coriolis_matrix": (coriolis._coriolis_batch, False, lambda m, q, v, a: rd.coriolis_matrix(m, q, v)),
+        "rnea_derivatives": (rnea_derivatives._derivatives_batch, False,
+                             lambda m, q, v, a: np.stack(rd.rnea_derivatives(m, q, v, a), axis=-3)),
+        "aba_derivatives": (aba_derivatives._derivatives_batch, False,
+                            lambda m, q, v, a: np.stack(rd.aba_derivatives(m, q, v, a), axis=-3)),
+        "inverse_mass_matrix": (minv._minv_batch, False, lambda m, q, v, a: rd.inverse_mass_matrix(m, q)),
+        "hybrid_dynamics": (hybrid._hybrid_batch, False,  # the base's acceleration unknown, the joints' known
+                            lambda m, q, v, a: np.concatenate(rd.hybrid_dynamics(m, q, v, a, a, np.arange(m.nv) >= 6),
+                                                              axis=-1)),
+        "forward_kinematics": (kinematics._fk_batch, False, lambda m, q, v, a: rd.forward_kinematics(m, q)),
+        "rnea (mimic couplings)": (rnea._rnea_coupled_batch, True, lambda m, q, v, a: rd.rnea(m, q, v, a)),
+        "crba (mimic couplings)": (crba._crba_coupled_batch, True, lambda m, q, v, a: rd.crba(m, q)),
+        "aba (mimic couplings)": (coupled._aba_coupled_batch, True, lambda m, q, v, a: rd.aba(m, q, v, a)),
+    }
+
+
+@pytest.mark.parametrize("name", list(_shared_code_cases()))
+def test_the_fast_path_runs_the_code_the_batch_runs(name, monkeypatch):
+    """A single state of contiguous float64 vectors runs, as a batch of one, the compiled code
+    (``run_range``, at ``one_address``) that a batch of such states runs: an algorithm's
+    per-state code is compiled once for both (``driver.BatchKernel``), and gives the same
+    numbers."""
+    batch, mimic, call = _shared_code_cases()[name]
+    model = random_model(5, seed=8, floating_base=True)
+    model = _coupled(model) if mimic else model
+    Q, V, A = random_state(model, np.random.default_rng(8), (3,))
+    addresses, loop = [], batch.loop
+    monkeypatch.setattr(batch, "loop", lambda address, *args: (addresses.append(address), loop(address, *args))[1])
+    many = call(model, Q, V, A)
+    assert addresses == [batch.one_address]
+    for s in range(3):
+        assert_rel(call(model, Q[s], V[s], A[s]), many[s], 0.0)

@@ -135,12 +135,12 @@ def test_batch_of_wrenches(frame):
     check_wrench_batches(rd.rnea_derivatives, random_model(5, seed=35, floating_base=True), frame, 4, 1e-12)
 
 
-def check_paths(fun, packed):
+def check_paths(fun, packed, batch):
     """Plain float64 vectors take the compiled fast path ``packed`` (checked), lists and a zero
     wrench the general path: the same results."""
     model = random_model(6, seed=33, floating_base=True)
     q, v, x = states(model, "paths")
-    fast = kernels.fast_path(packed, model, q, v, x, True, True, True)
+    fast = kernels.fast_path(packed, batch, model, q, v, x, True, True, True)
     assert fast is not None
     for other in (fun(model, list(q), list(v), list(x)), fun(model, q, v, x, np.zeros((model.nbodies, 6)))):
         for mine, theirs in zip(other, fast):
@@ -155,7 +155,7 @@ def check_bad_input(fun, names, aspect):
 
 
 def test_general_path_equals_the_fast_path():
-    check_paths(rd.rnea_derivatives, kernels._derivatives_packed)
+    check_paths(rd.rnea_derivatives, kernels._derivatives_packed, kernels._derivatives_batch)
 
 
 @input_checks

@@ -91,11 +91,12 @@ def test_a_failing_compiling_process_is_an_error_naming_its_step():
         rd.warmup(processes=0)
 
 
-def test_groups_keep_a_functions_steps_together_and_contact_simulations_first():
+def test_groups_keep_a_functions_steps_together_and_the_simulations_first():
     names = [name for name, _ in W.steps()]
     groups = W._groups(names)
     assert sorted(sum(groups, [])) == sorted(names)
     assert groups[0] == [name for name in names if "contacts" in name] and len(groups[0]) == 5
     assert not any("contacts" in name for g in groups[1:] for name in g)
+    assert groups[1] == [name for name in names if name.startswith("simulate") and "contacts" not in name]
     rnea = [g for g in groups if g[0].startswith("rnea (")]
     assert len(rnea) == 1 and len(rnea[0]) == 6  # fixed and floating base, one state and batch; the mimic ones

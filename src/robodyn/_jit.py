@@ -156,9 +156,11 @@ exact = _jit(compiled_callers_only=True, _nrt=False, **dict(_BASE, fastmath={"co
 
 VEC = _types.Array(_types.float64, 1, "C")
 MAT = _types.Array(_types.float64, 2, "C")
+TENSOR = _types.Array(_types.float64, 3, "C")
 MODEL_INTS = _types.Array(_types.int64, 2, "C")
 MODEL_PACKED = _types.Array(_types.float64, 1, "C")
 INTS = _types.Array(_types.int64, 1, "C")
+BOOLS = _types.Array(_types.boolean, 1, "C")
 
 
 def fast(*argtypes):

@@ -218,12 +218,13 @@ def _groups(names: list[str]) -> list[list[str]]:
     """The steps in groups that one process compiles: a function's steps together (they share
     its kernels), the simulations with contacts together and first (the longest compilation;
     the tree's and the coupled model's share the contact solver and the dynamics terms, which
-    two processes would compile at once)."""
+    two processes would compile at once), then the other simulations (the next longest), then
+    the algorithms in order: the short groups last, so that the processes finish together."""
     groups: dict[str, list[str]] = {}
     for name in names:
         key = "contacts" if "contacts" in name else name.split(" (")[0]
         groups.setdefault(key, []).append(name)
-    return sorted(groups.values(), key=lambda g: "contacts" not in g[0])  # stable: the rest in order
+    return sorted(groups.values(), key=lambda g: ("contacts" not in g[0], g[0].split(" (")[0] != "simulate"))
 
 
 SERVE = "from robodyn._warmup import _serve; _serve()"

@@ -11,12 +11,12 @@ The value checks run inside the compiled kernels (see ``status``).
 from __future__ import annotations
 
 import numpy as np
+from numba import int64
 
-from .._jit import inline
+from .._jit import inline, splice
 from ..layout import BODY_COLUMNS, DOF_COLUMNS, IV, NDOF, PARAMS_SIZE
 from ._lazy import is_lazy
-from ._workspace import view
-from .driver import chunks
+from ._workspace import row, view
 from .status import NO_WRENCH, OK, raise_for_coupled
 
 
@@ -141,6 +141,13 @@ def body_wrenches(model, f_ext, batch: tuple, frame: str) -> tuple[np.ndarray, i
     return f, codes[frame]
 
 
+def batched(batch: tuple, *arrays) -> tuple:
+    """The kernel arrays of a call as a batch: unchanged for a batch, each with a leading axis
+    of one (a view) for a single state (``batch == ()``), which runs the batch's compiled code
+    (``driver.BatchKernel.serial``)."""
+    return arrays if batch != () else tuple(a[None] for a in arrays)
+
+
 def fast_out(out, shape: tuple):
     """The output array of a single-state fast path: ``out`` itself, or a new
     ``np.empty(shape)`` when it is None. The fast kernels are compiled for a C-contiguous,
@@ -164,6 +171,36 @@ def fits(out, n, x, y, z):
     """The single-state output check of a fast path: ``out`` is (n,) or (n, n) and shares no
     memory with the inputs ``x, y, z`` (pass an input again where there are fewer)."""
     return out.shape[0] == n and out.size == n ** out.ndim and apart(out, x) and apart(out, y) and apart(out, z)
+
+
+# The arguments of a fast path's single state for its batch code, a batch of one
+# (``driver.BatchKernel.call_one``): ``(fits, args)``, ``fits`` as :func:`fits` for the output.
+
+@splice
+def one_state(ints, packed, q, v, x, check, out):
+    """``(q, v, x) -> out`` (nv,) without external wrenches: ``args = (ints, body, dofs, params,
+    Q, V, X, F, NO_WRENCH, check, OUT)`` (``rnea``, ``aba``)."""
+    body, dofs, params, zero = unpack(ints, packed)
+    return (fits(out, dofs.shape[0], q, v, x),
+            (ints, body, dofs, params, row(q), row(v), row(x), row(zero), int64(NO_WRENCH), check, row(out)))
+
+
+@splice
+def coupled_one_state(ints, packed, cints, cfloats, q, v, x, check, out):
+    """:func:`one_state` of a model with mimic couplings (``cints, cfloats``: its
+    ``CouplingTables``): ``args = (ints, body, dofs, params, cints, cfloats, Q, V, X, F,
+    NO_WRENCH, check, OUT)``."""
+    body, dofs, params, zero = unpack(ints, packed)
+    return (fits(out, cints[1], q, v, x), (ints, body, dofs, params, cints, cfloats, row(q), row(v), row(x),
+                                           row(zero), int64(NO_WRENCH), check, row(out)))
+
+
+@splice
+def matrix_one_state(ints, packed, q, check, M):
+    """``q -> M`` (nv, nv): ``args = (ints, body, dofs, Q, check, MM)`` (``crba``,
+    ``inverse_mass_matrix``)."""
+    body, dofs, _, _ = unpack(ints, packed)
+    return fits(M, dofs.shape[0], q, q, q), (ints, body, dofs, row(q), check, row(M))
 
 
 def output(out, batch: tuple, tail: tuple, inputs: dict) -> tuple[np.ndarray, np.ndarray]:
@@ -201,35 +238,29 @@ def unflatten(out: np.ndarray, batch: tuple) -> np.ndarray:
     return out if batch == () else out.reshape(batch + out.shape[1:])
 
 
-NO_WRENCHES = np.zeros((0, 6))  # ``fext`` of a single-state kernel call without external wrenches (never read)
-
-
 def coupled_call(model, one, batch, sizes, third: str, q, v, x, f_ext, frame: str, friction: bool,
                  armature: bool, check: bool, out, what: str) -> np.ndarray:
     """A per-state algorithm ``(q, v, x) -> (nv,)`` of a :class:`~robodyn.coupling.CoupledModel`
-    (``x`` named ``third``: ``a`` or ``tau``) by its compiled single-state kernel ``one(ints,
-    packed, cints, cfloats, q, v, x, fext, fcode, check, out)`` (a contiguous float64 state
-    without wrenches goes straight to it) or its batch kernel ``batch`` (workspace ``sizes``),
-    the full tree's tables and the coupling's; errors name the caller's arrays (``what``)."""
+    (``x`` named ``third``: ``a`` or ``tau``) by its batch kernel ``batch`` (workspace
+    ``sizes``; a single state as a batch of one), the full tree's tables and the coupling's; a
+    contiguous float64 state without wrenches goes straight to the compiled single-state
+    kernel ``one(address, ints, packed, cints, cfloats, q, v, x, check, out)``, which runs the
+    batch's code at ``batch.one_address``; errors name the caller's arrays (``what``)."""
     full, tables, k = model.full, model.tables, model.full.kernel
-    packed = k.packed[bool(friction), bool(armature)]
     if f_ext is None and frame in WRENCH_FRAMES:
         res = fast_out(out, (model.nv,))
         try:  # one state of contiguous float64 vectors (the dispatcher raises TypeError otherwise)
-            if one(k.ints, packed, tables.ints, tables.floats, q, v, x, NO_WRENCHES, NO_WRENCH, check, res) == OK:
+            if one(batch.one_address, k.ints, k.packed[bool(friction), bool(armature)], tables.ints, tables.floats,
+                   q, v, x, check, res) == OK:
                 return res
         except TypeError:
             pass
     shape, xs = states(model, q=q, v=v, **{third: x})
     F, fcode = body_wrenches(full, f_ext, shape, frame)
     res, result = output(out, shape, (model.nv,), xs)
-    if shape == ():
-        status = one(k.ints, packed, tables.ints, tables.floats, xs["q"], xs["v"], xs[third],
-                     np.array(F, order="C") if fcode >= 0 else NO_WRENCHES, fcode, check, res)
-    else:
-        B = xs["q"].shape[0]
-        status = np.empty(B, dtype=np.int64)
-        batch((k.ints, k.body, k.dofs[(bool(friction), bool(armature))], k.params[True], tables.ints, tables.floats,
-               xs["q"], xs["v"], xs[third], F, fcode, check, res), sizes, status, chunks(B))
+    Q, V, X, F, R = batched(shape, xs["q"], xs["v"], xs[third], F, res)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    batch.run((k.ints, k.body, k.dofs[(bool(friction), bool(armature))], k.params[True], tables.ints, tables.floats,
+               Q, V, X, F, fcode, check, R), sizes, status, shape)
     raise_for_coupled(model, status, xs, what)
     return result

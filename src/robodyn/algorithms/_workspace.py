@@ -58,6 +58,13 @@ def take(buf, o, shape):
     return view(buf, o, shape), o + n
 
 
+@splice
+def row(x):
+    """``x`` as a batch of one state: the view of shape ``(1,) + x.shape`` (owning no memory),
+    for a single-state kernel that runs its algorithm's batch code (``driver.BatchKernel``)."""
+    return view(x, 0, (1,) + x.shape)
+
+
 POSES_SIZE_NB, POSES_SIZE = 24, 12  # entries of :func:`poses`: 24 nb + 12
 
 

@@ -32,10 +32,10 @@ used by ``hybrid.py``): the ABA is its case with no joint of known acceleration.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean
+from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch, splice
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch, splice
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import local_placement, nq_of, passive_torque
 from ..joints import FREE
@@ -48,9 +48,9 @@ from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
-from ._inputs import fits, unpack
-from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
-from .driver import batch_kernel, chunks
+from ._inputs import one_state
+from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, result_status
+from .driver import batch_kernel
 
 # D_i is singular when a pivot is below this fraction of the body's articulated inertia scale.
 SINGULAR_RTOL = 1e-12
@@ -81,12 +81,19 @@ def workspace_views(buf, nb, nv):
 
 
 @scratch
+def buffer(nb, nv):
+    """``(buffer, known)``: the memory of :func:`workspace` and its ``known``, the workspace of
+    the batch code (which carves the views once per chunk, :func:`aba_views`)."""
+    return np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156), np.zeros(nv, dtype=np.bool_)
+
+
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`hybrid_state`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, c, IA, pA, acc, U,
     Dinv, u, UD, G, d, S, Ia, t1, t2, tau, known)``; ``tau`` receives :func:`aba_one`'s copy
     of the joint forces and ``known`` is all False (no joint of known acceleration)."""
-    buf = np.empty((POSES_SIZE_NB + 63) * nb + 20 * nv + POSES_SIZE + 156)
-    return (buf,) + workspace_views(buf, nb, nv) + (np.zeros(nv, dtype=np.bool_),)
+    buf, known = buffer(nb, nv)
+    return (buf,) + workspace_views(buf, nb, nv) + (known,)
 
 
 @inline
@@ -364,9 +371,10 @@ def hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fe
     alike); with no dof known this is the ABA. Returns a status (see
     ``_inputs``): ``i + 1`` when the articulated inertia of body ``i`` is singular.
 
-    Inlined into :func:`hybrid_one`, the function every single-state caller shares, and into
-    the batch loop :func:`aba_at`, where a call per state would cost about a tenth of the
-    work.
+    Inlined into :func:`hybrid_one`, the function other kernels call (the simulation, the
+    hybrid dynamics), and into :func:`aba_at`, the state of the batch code (which ``aba``
+    runs for a single state too, as a batch of one), where a call per state would cost about
+    a tenth of the work.
 
     Spatial quantities of body ``i`` are expressed at its origin with world axes (see the
     module docstring): ``S[k]`` is motion-subspace column ``k`` turned into world axes, and
@@ -532,27 +540,23 @@ def aba_at(args, s, ws):
 
 @inline
 def aba_views(args, ws):
-    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
-    return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0]) + (ws[18],)
+    """The workspace views carved once per chunk from the buffer, where the compiler sees
+    their shapes."""
+    return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0]) + (ws[1],)
 
 
-_aba_batch = batch_kernel(aba_at, workspace, aba_views)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, MAT), (int64, int64))
+_aba_batch = batch_kernel(aba_at, buffer, aba_views, ONE_STATE)
+_aba_call_one = _aba_batch.call_one
 
 
-@kernel
-def _aba_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd):
-    return aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd,
-                   workspace(ints.shape[0], dofs.shape[0]))
-
-
-@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
-def _aba_packed(ints, packed, q, v, tau, check, qdd):
-    """One state without external wrenches, the model in one array (the fast path)."""
-    body, dofs, params, zero = unpack(ints, packed)
-    if not fits(qdd, dofs.shape[0], q, v, tau):
-        return WRONG_SIZE
-    return aba_one(ints, body, dofs, params, q, v, tau, zero, NO_WRENCH, check, qdd,
-                   workspace(ints.shape[0], dofs.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
+def _aba_packed(address, ints, packed, q, v, tau, check, qdd):
+    """One state without external wrenches, the model in one array (the fast path): the
+    batch's code at ``address`` (``_aba_batch.one_address``) for a batch of one."""
+    ok, args = one_state(ints, packed, q, v, tau, check, qdd)
+    return _aba_call_one(address, args, buffer(ints.shape[0], qdd.shape[0])) if ok else WRONG_SIZE
 
 
 def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = True,
@@ -581,7 +585,8 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
         qdd = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks
         try:  # sizes and values
             k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-            if _aba_packed(k.ints, k.packed[friction, armature], q, v, tau, check_finite, qdd) == OK:
+            if _aba_packed(_aba_batch.one_address, k.ints, k.packed[friction, armature], q, v, tau, check_finite,
+                           qdd) == OK:
                 return qdd
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass
@@ -594,12 +599,9 @@ def aba(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = 
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     qdd, result = _inputs.output(out, batch, (model.nv,), x)
-    if batch == ():
-        status = _aba_single(k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd)
-    else:
-        B = x["q"].shape[0]
-        status = np.empty(B, dtype=np.int64)
-        _aba_batch((k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, qdd),
-                   (model.nbodies, model.nv), status, chunks(B))
+    Q, V, T, F, QDD = _inputs.batched(batch, x["q"], x["v"], x["tau"], F, qdd)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    args, sizes = (k.ints, k.body, dofs, params, Q, V, T, F, fcode, check_finite, QDD), (model.nbodies, model.nv)
+    _aba_batch.run(args, sizes, status, batch)
     raise_singular(model, raise_for_status(model, status, x, "aba"), "aba")
     return result

@@ -21,10 +21,10 @@ algorithms", Robotics: Science and Systems, 2018, section IV.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean
+from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
 from ..coupling import is_coupled
 from . import coupled
 from ._lazy import any_lazy, deferred
@@ -33,7 +33,8 @@ from . import rnea as _rnea
 from . import minv as _minv
 from . import rnea_derivatives as _rd
 from ._inputs import fits, unpack
-from .driver import batch_kernel, chunks
+from ._workspace import row
+from .driver import batch_kernel
 from .status import (NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, finite2, raise_for_status, raise_singular,
                      result_status)
 
@@ -150,24 +151,24 @@ def derivatives_at(args, s, ws):
                            DQ[s], DV[s], MI[s], ws)
 
 
-_derivatives_batch = batch_kernel(derivatives_at, workspace)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, TENSOR, TENSOR, TENSOR),
+             (int64, int64))
+_derivatives_batch = batch_kernel(derivatives_at, workspace, one_state=ONE_STATE)
+_derivatives_call_one = _derivatives_batch.call_one
 
 
-@kernel
-def _derivatives_single(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv):
-    return derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv,
-                           workspace(ints.shape[0], dofs.shape[0]))
-
-
-@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, MAT, MAT, MAT)
-def _derivatives_packed(ints, packed, q, v, tau, check, da_dq, da_dv, Minv):
-    """One state without external wrenches, the model in one array (the fast path)."""
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, MAT, MAT, MAT)
+def _derivatives_packed(address, ints, packed, q, v, tau, check, da_dq, da_dv, Minv):
+    """One state without external wrenches, the model in one array (the fast path): the
+    batch's code at ``address`` (``_derivatives_batch.one_address``) for a batch of one."""
     body, dofs, params, zero = unpack(ints, packed)
     nv = dofs.shape[0]
     if not (fits(da_dq, nv, q, v, tau) and fits(da_dv, nv, q, v, tau) and fits(Minv, nv, q, v, tau)):
         return WRONG_SIZE
-    return derivatives_one(ints, body, dofs, params, q, v, tau, zero, NO_WRENCH, check, da_dq, da_dv, Minv,
-                           workspace(ints.shape[0], nv))
+    args = (ints, body, dofs, params, row(q), row(v), row(tau), row(zero), int64(NO_WRENCH), check, row(da_dq),
+            row(da_dv), row(Minv))
+    return _derivatives_call_one(address, args, workspace(ints.shape[0], nv))
 
 
 def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, friction: bool = True,
@@ -195,7 +196,8 @@ def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, frict
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "aba_derivatives()")
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
-        out = _rd.fast_path(_derivatives_packed, model, q, v, tau, friction, armature, check_finite)
+        out = _rd.fast_path(_derivatives_packed, _derivatives_batch, model, q, v, tau, friction, armature,
+                            check_finite)
         if out is not None:
             return out
     if is_coupled(model):  # mimic joints: -M^-1 G^T (dtau_full) G at qdd, and M^-1
@@ -210,11 +212,9 @@ def aba_derivatives(model, q, v, tau, f_ext=None, frame: str = "local", *, frict
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     (dq, rq), (dv, rv), (Mi, rM) = (_inputs.output(None, batch, (nv, nv), x) for _ in range(3))
-    args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["tau"], F, fcode, check_finite, dq, dv, Mi)
-    if batch == ():
-        status = _derivatives_single(*args)
-    else:
-        status = np.empty(x["q"].shape[0], dtype=np.int64)
-        _derivatives_batch(args, (model.nbodies, nv), status, chunks(status.shape[0]))
+    Q, V, T, F, DQ, DV, MI = _inputs.batched(batch, x["q"], x["v"], x["tau"], F, dq, dv, Mi)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    args = (k.ints, k.body, dofs, params, Q, V, T, F, fcode, check_finite, DQ, DV, MI)
+    _derivatives_batch.run(args, (model.nbodies, nv), status, batch)
     raise_singular(model, raise_for_status(model, status, x, "aba_derivatives"), "aba_derivatives")
     return rq, rv, rM

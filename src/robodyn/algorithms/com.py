@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel, scratch
+from .._jit import core, inline, scratch
 from ..layout import IV, NDOF, PARENT
 from ..coupling import expand_q, is_coupled, reduce_columns
 from ._lazy import any_lazy, deferred
@@ -21,7 +21,7 @@ from .status import raise_for_status
 from .crba import world_inertias
 from .status import OK, finite, finite2, result_status
 from .kinematics import poses_checked, world_motion_subspace
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 
 @scratch
@@ -76,11 +76,6 @@ def com_at(args, s, ws):
 _com_batch = batch_kernel(com_at, workspace)
 
 
-@kernel
-def _com_single(ints, body, dofs, q, check, c, Jc):
-    return com_one(ints, body, dofs, q, check, c, Jc, workspace(ints.shape[0], dofs.shape[0]))
-
-
 def _run(model, q, check_finite, with_jacobian, what):
     if is_coupled(model):  # the full tree's at E(q); the Jacobian J_full G
         batch, C, JC = _run(model.full, expand_q(model, q), check_finite, with_jacobian, what)
@@ -93,11 +88,8 @@ def _run(model, q, check_finite, with_jacobian, what):
     B = Q.shape[0]
     C, JC = np.empty((B, 3)), np.zeros((B, 3, model.nv if with_jacobian else 0))
     status = np.empty(B, dtype=np.int64)
-    if batch == ():  # one state: no parallel launch
-        status[0] = _com_single(k.ints, k.body, k.dofs[(False, False)], Q[0], check_finite, C[0], JC[0])
-    else:
-        _com_batch((k.ints, k.body, k.dofs[(False, False)], Q, check_finite, C, JC),
-                   (model.nbodies, model.nv), status, chunks(B))
+    _com_batch.run((k.ints, k.body, k.dofs[(False, False)], Q, check_finite, C, JC), (model.nbodies, model.nv),
+                   status, batch)
     raise_for_status(model, status, x, what)
     return batch, C, JC
 

@@ -21,12 +21,12 @@ from __future__ import annotations
 import numpy as np
 from numba import boolean, int64
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, fast, inline, scratch
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, fast, inline, scratch
 from ..coupling import expand_q, expand_v, reduce_force, reduce_matrix
 from ..coupling_kernels import expand_positions, expand_velocity, reduce_square, reduce_vector
 from ..joint_kernels import nq_of
 from . import _inputs
-from ._inputs import fits, unpack
+from ._inputs import coupled_one_state
 from ._workspace import view
 from .crba import crba, crba_one
 from .crba import workspace as crba_workspace
@@ -88,17 +88,19 @@ def aba_coupled_at(args, s, ws):
                              F[s if F.shape[0] > 1 else 0], fcode, check, QDD[s], ws)
 
 
-_aba_coupled_batch = batch_kernel(aba_coupled_at, aba_workspace)
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, INTS, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, MAT),
+             (int64, int64, int64, int64))
+_aba_coupled_batch = batch_kernel(aba_coupled_at, aba_workspace, one_state=ONE_STATE)
+_aba_coupled_call_one = _aba_coupled_batch.call_one
 
 
-@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
-def _aba_coupled_one(ints, packed, cints, cfloats, q, v, tau, fext, fcode, check, qdd):
-    """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
-    body, dofs, params, _ = unpack(ints, packed)
-    if not fits(qdd, cints[1], q, v, tau):
-        return WRONG_SIZE
-    return aba_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, tau, fext, fcode, check, qdd,
-                             aba_workspace(ints.shape[0], nq_of(ints), dofs.shape[0], cints[1]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, boolean, VEC)
+def _aba_coupled_one(address, ints, packed, cints, cfloats, q, v, tau, check, qdd):
+    """One state of a coupled model without external wrenches: the batch's code at ``address``
+    (``_aba_coupled_batch.one_address``) for a batch of one."""
+    ok, args = coupled_one_state(ints, packed, cints, cfloats, q, v, tau, check, qdd)
+    return (_aba_coupled_call_one(address, args, aba_workspace(ints.shape[0], nq_of(ints), args[2].shape[0], cints[1]))
+            if ok else WRONG_SIZE)
 
 
 def run_aba(model, q, v, tau, f_ext, frame: str, friction: bool, armature: bool, check: bool, out=None):

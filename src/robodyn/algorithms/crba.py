@@ -14,9 +14,9 @@ Returns the full symmetric matrix.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean
+from numba import boolean, int64
 
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
 from ..joint_kernels import nq_of
 from ..layout import ARMATURE, INERTIA, INERTIA_END, IV, NDOF, PARENT
 from ..spatial import dot6, inertia_act, inertia_mul
@@ -25,10 +25,10 @@ from ..coupling_kernels import expand_positions, reduce_square
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_coupled, raise_for_status
-from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import fits, unpack
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, row, take, view
+from ._inputs import fits, matrix_one_state, unpack
 from .status import NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 from .kinematics import poses_checked, world_motion_subspace
 
 
@@ -44,9 +44,16 @@ def workspace_views(buf, nb, nv):
 
 
 @scratch
+def buffer(nb, nv):
+    """``(buffer,)``: the memory of :func:`workspace`, the workspace of the batch code (which
+    carves the views once per chunk, :func:`crba_views`)."""
+    return (np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6),)
+
+
+@scratch
 def workspace(nb, nv):
     """Scratch of :func:`crba_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), oS, Ic, F)``."""
-    buf = np.empty((POSES_SIZE_NB + 10) * nb + 6 * nv + POSES_SIZE + 6)
+    buf = buffer(nb, nv)[0]
     return (buf,) + workspace_views(buf, nb, nv)
 
 
@@ -73,7 +80,8 @@ def world_state(ints, body, dofs, q, v, check, P, oS, Ic):
 @inline
 def crba_state(ints, body, dofs, q, check, M, ws):
     """``M`` (nv, nv) at ``q``; returns a status (see ``_inputs``). Inlined into
-    :func:`crba_one` (one state) and :func:`crba_at` (the batch loop)."""
+    :func:`crba_one` (one state, for other kernels) and :func:`crba_at` (the batch code,
+    which ``crba`` runs for a single state too, as a batch of one)."""
     _, P, oS, Ic, F = ws
     if q.shape[0] != nq_of(ints):
         return WRONG_SIZE
@@ -114,25 +122,23 @@ def crba_at(args, s, ws):
 
 @inline
 def crba_views(args, ws):
-    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    """The workspace views carved once per chunk from the buffer, where the compiler sees
+    their shapes."""
     return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0])
 
 
-_crba_batch = batch_kernel(crba_at, workspace, crba_views)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, MAT, boolean, TENSOR), (int64, int64))
+_crba_batch = batch_kernel(crba_at, buffer, crba_views, ONE_STATE)
+_crba_call_one = _crba_batch.call_one
 
 
-@kernel
-def _crba_single(ints, body, dofs, q, check, M):
-    return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
-
-
-@fast(MODEL_INTS, MODEL_PACKED, VEC, boolean, MAT)
-def _crba_packed(ints, packed, q, check, M):
-    """One state, the model in one array (the fast path)."""
-    body, dofs, _, _ = unpack(ints, packed)
-    if not fits(M, dofs.shape[0], q, q, q):
-        return WRONG_SIZE
-    return crba_one(ints, body, dofs, q, check, M, workspace(ints.shape[0], dofs.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, boolean, MAT)
+def _crba_packed(address, ints, packed, q, check, M):
+    """One state, the model in one array (the fast path): the batch's code at ``address``
+    (``_crba_batch.one_address``) for a batch of one."""
+    ok, args = matrix_one_state(ints, packed, q, check, M)
+    return _crba_call_one(address, args, buffer(ints.shape[0], M.shape[0])) if ok else WRONG_SIZE
 
 
 @scratch
@@ -169,39 +175,39 @@ def crba_coupled_at(args, s, ws):
     return crba_coupled_state(ints, body, dofs, cints, cfloats, Q[s], check, MM[s], ws)
 
 
-_crba_coupled_batch = batch_kernel(crba_coupled_at, coupled_workspace)
+COUPLED_ONE_STATE = ((MODEL_INTS, MAT, MAT, INTS, VEC, MAT, boolean, TENSOR), (int64, int64, int64))
+_crba_coupled_batch = batch_kernel(crba_coupled_at, coupled_workspace, one_state=COUPLED_ONE_STATE)
+_crba_coupled_call_one = _crba_coupled_batch.call_one
 
 
-@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, boolean, MAT)
-def _crba_coupled_one(ints, packed, cints, cfloats, q, check, M):
-    """One state of a coupled model."""
+@fast(int64, MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, boolean, MAT)
+def _crba_coupled_one(address, ints, packed, cints, cfloats, q, check, M):
+    """One state of a coupled model: the batch's code at ``address``
+    (``_crba_coupled_batch.one_address``) for a batch of one."""
     body, dofs, _, _ = unpack(ints, packed)
     if not fits(M, cints[1], q, q, q):
         return WRONG_SIZE
-    return crba_coupled_state(ints, body, dofs, cints, cfloats, q, check, M,
-                              coupled_workspace(ints.shape[0], nq_of(ints), dofs.shape[0]))
+    return _crba_coupled_call_one(address, (ints, body, dofs, cints, cfloats, row(q), check, row(M)),
+                                  coupled_workspace(ints.shape[0], nq_of(ints), dofs.shape[0]))
 
 
 def run_coupled(model, q, armature: bool, check: bool, out=None) -> np.ndarray:
     """:func:`crba` of a :class:`~robodyn.coupling.CoupledModel` (compiled: the full tree's
-    CRBA and the congruence ``G^T M G``, per state)."""
+    CRBA and the congruence ``G^T M G``, per state; a single state as a batch of one)."""
     tables, k = model.tables, model.full.kernel
-    packed = k.packed[False, bool(armature)]
     M = _inputs.fast_out(out, (model.nv, model.nv))
     try:  # one state, a contiguous float64 vector (the dispatcher raises TypeError otherwise)
-        if _crba_coupled_one(k.ints, packed, tables.ints, tables.floats, q, check, M) == OK:
+        if _crba_coupled_one(_crba_coupled_batch.one_address, k.ints, k.packed[False, bool(armature)], tables.ints,
+                             tables.floats, q, check, M) == OK:
             return M
     except TypeError:
         pass
     batch, x = _inputs.states(model, q=q)
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)
-    if batch == ():
-        status = _crba_coupled_one(k.ints, packed, tables.ints, tables.floats, x["q"], check, M)
-    else:
-        B = x["q"].shape[0]
-        status = np.empty(B, dtype=np.int64)
-        _crba_coupled_batch((k.ints, k.body, k.dofs[(False, bool(armature))], tables.ints, tables.floats, x["q"],
-                             check, M), (model.nbodies, model.full.nq, model.full.nv), status, chunks(B))
+    Q, MM = _inputs.batched(batch, x["q"], M)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    _crba_coupled_batch.run((k.ints, k.body, k.dofs[(False, bool(armature))], tables.ints, tables.floats, Q, check, MM),
+                            (model.nbodies, model.full.nq, model.full.nv), status, batch)
     raise_for_coupled(model, status, x, "crba")
     return result
 
@@ -220,7 +226,7 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     M = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks q, M
     try:
         k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-        if _crba_packed(k.ints, k.packed[False, armature], q, check_finite, M) == OK:
+        if _crba_packed(_crba_batch.one_address, k.ints, k.packed[False, armature], q, check_finite, M) == OK:
             return M
     except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or armature not bool)
         pass
@@ -229,13 +235,10 @@ def crba(model, q, *, armature: bool = True, check_finite: bool = True, out: np.
     if is_coupled(model):  # mimic joints: the compiled coupled path (after the fast path: free for a tree)
         return run_coupled(model, q, armature, check_finite, out)
     batch, x = _inputs.states(model, q=q)
-    dofs, q = k.dofs[(False, bool(armature))], x["q"]
     M, result = _inputs.output(out, batch, (model.nv, model.nv), x)
-    if batch == ():
-        status = _crba_single(k.ints, k.body, dofs, q, check_finite, M)
-    else:
-        status = np.empty(q.shape[0], dtype=np.int64)
-        _crba_batch((k.ints, k.body, dofs, q, check_finite, M), (model.nbodies, model.nv), status,
-                    chunks(q.shape[0]))
+    Q, M = _inputs.batched(batch, x["q"], M)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    args, sizes = (k.ints, k.body, k.dofs[(False, bool(armature))], Q, check_finite, M), (model.nbodies, model.nv)
+    _crba_batch.run(args, sizes, status, batch)
     raise_for_status(model, status, x, "crba")
     return result

@@ -9,8 +9,9 @@ An algorithm supplies three compiled pieces and gets its batch kernel from :func
 ``workspace(*sizes)``
     allocates one worker's scratch (called once per worker thread, never per state).
 ``views(args, ws) -> ws`` (optional)
-    rebuilds the workspace views once per chunk, where the compiler sees their constant
-    shapes (see ``_workspace``); without it the state function gets ``ws`` as allocated.
+    carves the workspace views once per chunk, where the compiler sees their constant
+    shapes (see ``_workspace``; the workspace is then just the memory); without it the
+    state function gets ``ws`` as allocated.
 
 The kernel, ``batch(args, sizes, status, nchunk)``, runs all states ``s < status.shape[0]``
 on all threads, ``nchunk = chunks(B)`` from Python. The batch is cut into ``nchunk`` chunks of
@@ -22,7 +23,8 @@ other for a while (another process, the hypervisor); with one fixed share of the
 thread, the fast thread would wait for the slow one, with claimed chunks it takes more of the
 batch. Which worker computes a state never changes its result: every state is computed alone.
 A chunk is computed by one compiled function called at its address (:class:`BatchKernel`),
-so that the per-state code is compiled once, not once more inside each piece of the loop.
+so that the per-state code is compiled once, not once more inside each piece of the loop;
+a single state runs that same function as a batch of one.
 
 A batch whose one state is a whole simulation (``rollout``) uses :func:`threaded_batch_kernel`
 instead: the same workers and chunks, on Python threads (see there for why).
@@ -34,6 +36,7 @@ the compiled functions it closes over, which differ in every process, so it woul
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 import sys
@@ -45,6 +48,7 @@ from llvmlite import ir
 from numba import prange, typeof, types
 from numba._dispatcher import compute_fingerprint
 from numba.core import cgutils
+from numba.core.errors import TypingError
 from numba.extending import intrinsic
 
 from .._jit import SharedCache, core, inline, kernel, parallel
@@ -113,9 +117,11 @@ def _cached(dispatcher):
     return dispatcher
 
 
-def batch_kernel(state_at, workspace, views=None):
+def batch_kernel(state_at, workspace, views=None, one_state=None):
     """The parallel batch kernel ``batch(args, sizes, status, nchunk)`` of an algorithm whose
-    one state is ``state_at(args, s, ws)`` (see the module docstring): a :class:`BatchKernel`."""
+    one state is ``state_at(args, s, ws)`` (see the module docstring): a :class:`BatchKernel`.
+    ``one_state``: the Numba types of ``(args, sizes)`` that the algorithm's single-state
+    kernel builds for a batch of one (see :meth:`BatchKernel.call_one`)."""
 
     if views is None:
         def run_range(args, status, lo, hi, ws):
@@ -136,7 +142,13 @@ def batch_kernel(state_at, workspace, views=None):
                 call_chunk(address, args, status, lo, hi, ws)
                 lo, hi = claim(counter, B, nchunk)
 
-    return BatchKernel(_cached(core(run_range)), workspace, _cached(parallel(loop)))
+    def here(address, args, sizes, status):
+        call_chunk(address, args, status, 0, status.shape[0], workspace(*sizes))
+
+    return BatchKernel(_cached(core(run_range)), workspace, _cached(parallel(loop)), _cached(kernel(here)), one_state)
+
+
+STATUS = types.Array(types.int64, 1, "C")
 
 
 class BatchKernel:
@@ -152,35 +164,115 @@ class BatchKernel:
     kernel compiles in half the time, at the same speed: the call is once per chunk).
     ``run_range`` is compiled for each new combination of argument types (the key: Numba's
     fingerprint of the arguments, as its own dispatch uses), the workspace's type from
-    ``workspace`` compiled for ``sizes``; both are cached on disk like every kernel."""
+    ``workspace`` compiled for ``sizes``; both are cached on disk like every kernel.
 
-    def __init__(self, run_range, workspace, loop):
-        self.run_range, self.workspace, self.loop = run_range, workspace, loop
+    A single state is a batch of one and runs the same compiled ``run_range``, so that an
+    algorithm's per-state code is compiled once for single calls and batches alike:
+    :meth:`serial` from Python (the states in the calling thread, no parallel loop to start),
+    :meth:`call_one` from a compiled single-state kernel (the fast paths), which gets the
+    address, :attr:`one_address`, as an argument."""
+
+    def __init__(self, run_range, workspace, loop, here=None, one_state=None):
+        self.run_range, self.workspace, self.loop, self.here = run_range, workspace, loop, here
+        self.one_state = one_state
+        self.call_one = _one_state_call(self)
         self._addresses: dict = {}
         self._lock = threading.Lock()
 
     def __call__(self, args, sizes, status, nchunk):
+        self.loop(self._address(args, sizes, status), args, sizes, status, nchunk)
+
+    def run(self, args, sizes, status, batch: tuple):
+        """A call's states: a single state (``batch == ()``, its arrays with a leading axis of
+        one) in the calling thread (:meth:`serial`), a batch on all threads."""
+        if batch == ():
+            self.serial(args, sizes, status)
+        else:
+            self(args, sizes, status, chunks(status.shape[0]))
+
+    def serial(self, args, sizes, status):
+        """All states of the batch in the calling thread (for a single state: a batch of one,
+        without starting the parallel loop's threads)."""
+        self.here(self._address(args, sizes, status), args, sizes, status)
+
+    def _address(self, args, sizes, status) -> int:
         try:
             key = compute_fingerprint((args, sizes, status))
         except NotImplementedError:  # a value Numba's fast path does not type: its full type
             key = typeof((args, sizes, status))
         address = self._addresses.get(key)
         if address is None:
-            address = self._compile(key, args, sizes, status)
-        self.loop(address, args, sizes, status, nchunk)
+            address = self._compile(key, typeof(args), tuple(typeof(sizes)), typeof(status))
+        return address
 
     def _compile(self, key, args, sizes, status) -> int:
-        """Compiles (or loads) ``run_range`` for these arguments; its address."""
+        """Compiles (or loads) ``run_range`` for these argument types; its address."""
         with self._lock:
             if key not in self._addresses:
-                shapes = tuple(typeof(sizes))
-                self.workspace.compile(shapes)
-                ws = self.workspace.overloads[shapes].signature.return_type
-                signature = types.none(typeof(args), typeof(status), types.int64, types.int64, ws)
+                ws = self.workspace_type(sizes)
+                signature = types.none(args, status, types.int64, types.int64, ws)
                 self.run_range.compile(signature)
                 compiled = self.run_range.overloads[signature.args]
                 self._addresses[key] = compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
             return self._addresses[key]
+
+    def workspace_type(self, sizes):
+        """The type of the workspace allocated for ``sizes`` (a tuple of Numba types)."""
+        self.workspace.compile(sizes)
+        return self.workspace.overloads[sizes].signature.return_type
+
+    @functools.cached_property
+    def one_address(self) -> int:
+        """The address of ``run_range`` compiled for the single-state types ``one_state``
+        (passed to the single-state kernel that calls :meth:`call_one`)."""
+        args, sizes = self.one_state
+        return self._compile(("one state",), types.Tuple(args), tuple(sizes), STATUS)
+
+
+def _one_state_call(batch):
+    """``call_one(address, args, ws) -> status``: the compiled single-state kernel's call of
+    ``batch``'s ``run_range`` at ``address`` (:attr:`BatchKernel.one_address`) for the one
+    state ``args`` (its arrays with a leading axis of one) with the workspace ``ws``; the
+    status lives on the stack. The types of ``args`` and ``ws`` must be the declared
+    ``one_state`` (a compile-time error otherwise: the address is of code compiled for
+    those)."""
+
+    @intrinsic
+    def call_one(typingctx, address, args, ws):
+        if batch.one_state is None:
+            raise TypingError("call_one: the batch kernel declares no one_state types")
+        declared, sizes = batch.one_state
+        if args != types.Tuple(declared) or ws != batch.workspace_type(tuple(sizes)):
+            raise TypingError(f"call_one: the single state's arguments are {args} with workspace {ws}, "
+                              f"not the declared one_state {types.Tuple(declared)} for sizes {tuple(sizes)}")
+        if not isinstance(address, types.Integer):
+            return None
+
+        def codegen(context, builder, signature, llargs):
+            cell = cgutils.alloca_once(builder, ir.IntType(64))
+            builder.store(ir.Constant(ir.IntType(64), 0), cell)
+            status = context.make_array(STATUS)(context, builder)
+            intp = context.get_value_type(types.intp)
+            context.populate_array(status, data=cell, shape=cgutils.pack_array(builder, [ir.Constant(intp, 1)]),
+                                   strides=cgutils.pack_array(builder, [ir.Constant(intp, 8)]),
+                                   itemsize=ir.Constant(intp, 8), meminfo=None)
+            zero, one = context.get_constant(types.int64, 0), context.get_constant(types.int64, 1)
+            _call_at(context, builder, llargs[0], (args, STATUS, types.int64, types.int64, ws),
+                     (llargs[1], status._getvalue(), zero, one, llargs[2]))
+            return builder.load(cell)
+
+        return types.int64(address, args, ws), codegen
+
+    return call_one
+
+
+def _call_at(context, builder, address, argtypes, llargs) -> None:
+    """Emits the call of the compiled function ``(*argtypes) -> None`` at ``address`` (Numba's
+    calling convention); an exception it raises propagates to the caller."""
+    callee = builder.inttoptr(address, context.call_conv.get_function_type(types.none, argtypes).as_pointer())
+    returned, _ = context.call_conv.call_function(builder, callee, types.none, argtypes, llargs)
+    with cgutils.if_unlikely(builder, returned.is_error):
+        context.call_conv.return_status_propagate(builder, returned)
 
 
 @intrinsic
@@ -193,10 +285,7 @@ def call_chunk(typingctx, address, args, status, lo, hi, ws):
     argtypes = (args, status, lo, hi, ws)
 
     def codegen(context, builder, signature, llargs):
-        callee = builder.inttoptr(llargs[0], context.call_conv.get_function_type(types.none, argtypes).as_pointer())
-        returned, _ = context.call_conv.call_function(builder, callee, types.none, argtypes, llargs[1:])
-        with cgutils.if_unlikely(builder, returned.is_error):
-            context.call_conv.return_status_propagate(builder, returned)
+        _call_at(context, builder, llargs[0], argtypes, llargs[1:])
         return context.get_dummy_value()
 
     return types.none(address, *argtypes), codegen

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline
 from ..layout import INERTIA, INERTIA_END
 from ..spatial import dot6, inertia_mul
 from ..coupling import expand_q, expand_v
@@ -21,7 +21,7 @@ from .status import raise_for_status
 from .status import OK, finite, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 
 @core
@@ -57,11 +57,6 @@ def energy_at(args, s, ws):
 _energy_batch = batch_kernel(energy_at, motion_workspace)
 
 
-@kernel
-def _energy_single(ints, body, dofs, grav, q, v, check, out):
-    return energy_one(ints, body, dofs, grav, q, v, check, out, motion_workspace(ints.shape[0], dofs.shape[0]))
-
-
 def _run(model, check_finite, what, **arrays):
     batch, x = _inputs.states(model, **arrays)
     try:
@@ -73,12 +68,8 @@ def _run(model, check_finite, what, **arrays):
     V = _inputs.as_batch(x["v"]) if "v" in x else np.zeros((1, 0))
     B = Q.shape[0]
     OUT, status = np.empty((B, 2)), np.empty(B, dtype=np.int64)
-    if batch == ():  # one state: no parallel launch
-        status[0] = _energy_single(k.ints, k.body, k.dofs[(False, False)], model.gravity, Q[0], V[0],
-                                   check_finite, OUT[0])
-    else:
-        _energy_batch((k.ints, k.body, k.dofs[(False, False)], model.gravity, Q, V, check_finite, OUT),
-                      (model.nbodies, model.nv), status, chunks(B))
+    _energy_batch.run((k.ints, k.body, k.dofs[(False, False)], model.gravity, Q, V, check_finite, OUT),
+                      (model.nbodies, model.nv), status, batch)
     raise_for_status(model, status, x, what)
     return batch, OUT
 

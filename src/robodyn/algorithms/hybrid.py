@@ -26,16 +26,19 @@ from __future__ import annotations
 import numpy as np
 
 from .._deprecated import renamed_keyword
-from .._jit import inline, kernel
+from numba import boolean, int64
+
+from .._jit import BOOLS, MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, fast, inline
 from .. import joints as J
 from ..coupling import is_coupled
 from . import coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
-from .status import raise_for_status
-from .status import OK
+from .status import NO_WRENCH, OK, WRONG_SIZE, first_failure, raise_for_status
+from ._inputs import fits, unpack
+from ._workspace import row
 from .aba import hybrid_one, workspace
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 
 @inline
@@ -46,13 +49,24 @@ def hybrid_at(args, s, ws):
                       fcode, check, QDD[s], TAU[s], ws)
 
 
-_hybrid_batch = batch_kernel(hybrid_at, workspace)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, MAT, BOOLS, TENSOR, int64, boolean, MAT, MAT), (int64, int64))
+_hybrid_batch = batch_kernel(hybrid_at, workspace, one_state=ONE_STATE)
+_hybrid_call_one = _hybrid_batch.call_one
 
 
-@kernel
-def _hybrid_single(ints, body, dofs, params, q, v, a, tau_in, known, fext, fcode, check, qdd, tau):
-    return hybrid_one(ints, body, dofs, params, q, v, a, tau_in, known, fext, fcode, check, qdd, tau,
-                      workspace(ints.shape[0], dofs.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, VEC, BOOLS, boolean, VEC, VEC)
+def _hybrid_packed(address, ints, packed, q, v, a_known, tau_known, known, check, qdd, tau):
+    """One state without external wrenches, the model in one array (the fast path): the
+    batch's code at ``address`` (``_hybrid_batch.one_address``) for a batch of one."""
+    body, dofs, params, zero = unpack(ints, packed)
+    nv = dofs.shape[0]
+    if not (fits(qdd, nv, q, v, a_known) and fits(tau, nv, q, v, tau_known) and fits(qdd, nv, tau, tau, tau)
+            and known.shape[0] == nv):
+        return WRONG_SIZE
+    args = (ints, body, dofs, params, row(q), row(v), row(a_known), row(tau_known), known, row(zero),
+            int64(NO_WRENCH), check, row(qdd), row(tau))
+    return _hybrid_call_one(address, args, workspace(ints.shape[0], nv))
 
 
 def known_dofs(model, known_mask) -> np.ndarray:
@@ -136,14 +150,14 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, fra
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "hybrid_dynamics()")
     known = known_dofs(model, known_mask)
-    if f_ext is None and frame in _inputs.WRENCH_FRAMES and _inputs.vectors(q, v, a_known, tau_known):
+    if f_ext is None and frame in _inputs.WRENCH_FRAMES:
         a, tau = np.empty(model.nv), np.empty(model.nv)  # fast path for one state: the kernel checks
         try:
             k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-            if _hybrid_single(k.ints, k.body, k.dofs[(bool(friction), bool(armature))], k.params[True], q, v,
-                              a_known, tau_known, known, k.zero_wrench, -1, check_finite, a, tau) == OK:
+            if _hybrid_packed(_hybrid_batch.one_address, k.ints, k.packed[friction, armature], q, v, a_known,
+                              tau_known, known, check_finite, a, tau) == OK:
                 return a, tau
-        except AttributeError:
+        except (TypeError, KeyError, AttributeError):  # not contiguous float64 vectors (or options not bool)
             pass
     if any_lazy(q, v, a_known, tau_known, f_ext):
         return deferred(hybrid_dynamics, locals())
@@ -153,16 +167,12 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, fra
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[True]
     batch, x = _inputs.states(model, q=q, v=v, a_known=a_known, tau_known=tau_known)
     F, fcode = _inputs.body_wrenches(model, f_ext, batch, frame)
-    args = (k.ints, k.body, dofs, params, x["q"], x["v"], x["a_known"], x["tau_known"], known, F, fcode,
-            check_finite)
-    if batch == ():
-        a, tau = np.empty(model.nv), np.empty(model.nv)
-        status = _hybrid_single(*args, a, tau)
-    else:
-        B = x["q"].shape[0]
-        a, tau, status = np.empty((B, model.nv)), np.empty((B, model.nv)), np.empty(B, dtype=np.int64)
-        _hybrid_batch((*args, a, tau), (model.nbodies, model.nv), status, chunks(B))
-    if np.any(status):
+    (a, ra), (tau, rtau) = (_inputs.output(None, batch, (model.nv,), x) for _ in range(2))
+    Q, V, A, T, F, QDD, TAU = _inputs.batched(batch, x["q"], x["v"], x["a_known"], x["tau_known"], F, a, tau)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    _hybrid_batch.run((k.ints, k.body, dofs, params, Q, V, A, T, known, F, fcode, check_finite, QDD, TAU),
+                      (model.nbodies, model.nv), status, batch)
+    if first_failure(status) != OK:
         report = {"q": x["q"], "v": x["v"], "a_known": np.where(known, x["a_known"], 0.0),
                   "tau_known": np.where(known, 0.0, x["tau_known"])}
         bad = raise_for_status(model, status, report, "hybrid_dynamics")
@@ -171,4 +181,4 @@ def hybrid_dynamics(model, q, v, a_known, tau_known, known_mask, f_ext=None, fra
             f"hybrid_dynamics: the articulated inertia of body {i} ({model.link_names[i]!r}, joint "
             f"{model.body_joint_names[i]!r}) is singular, so its acceleration is undefined; prescribe the "
             "acceleration of that joint, or give the bodies beyond it mass and inertia (or armature)")
-    return _inputs.unflatten(a, batch), _inputs.unflatten(tau, batch)
+    return ra, rtau

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel
+from .._jit import core, inline
 from ..layout import IV, MOTION, NDOF, PARENT
 from ..spatial import motion_act
 from ..coupling import expand_q, expand_v, is_coupled, reduce_columns
@@ -28,7 +28,7 @@ from .status import raise_for_status
 from .status import OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import motion_pass, motion_workspace
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 FRAMES = ("world", "local", "local_world_aligned")
 
@@ -70,12 +70,6 @@ def jacobian_at(args, s, ws):
 _jacobian_batch = batch_kernel(jacobian_at, motion_workspace)
 
 
-@kernel
-def _jacobian_single(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b):
-    ws = motion_workspace(ints.shape[0], dofs.shape[0])
-    return jacobian_one(ints, body, dofs, q, v, b, check, J, oRb, opb, acc_b, vel_b, ws)
-
-
 def jacobian_pass(model, x, b, check, what):
     """The pass behind the Jacobian functions, for the checked states ``x`` (``"q"``, optionally
     ``"v"``, see ``_inputs.states``) and body ``b``: flat-batch arrays ``(J, oR_b, op_b, acc_b,
@@ -93,12 +87,8 @@ def jacobian_pass(model, x, b, check, what):
     B = q.shape[0]
     JJ, OR, OP = np.empty((B, 6, model.nv)), np.empty((B, 3, 3)), np.empty((B, 3))
     ACC, VEL, status = np.empty((B, 6)), np.empty((B, 6)), np.empty(B, dtype=np.int64)
-    if x["q"].ndim == 1:  # one state: no parallel launch
-        status[0] = _jacobian_single(k.ints, k.body, k.dofs[(False, False)], q[0], v[0], b, check, JJ[0],
-                                     OR[0], OP[0], ACC[0], VEL[0])
-    else:
-        _jacobian_batch((k.ints, k.body, k.dofs[(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL),
-                        (model.nbodies, model.nv), status, chunks(B))
+    _jacobian_batch.run((k.ints, k.body, k.dofs[(False, False)], q, v, b, check, JJ, OR, OP, ACC, VEL),
+                        (model.nbodies, model.nv), status, () if x["q"].ndim == 1 else (B,))
     raise_for_status(model, status, x, what)
     return JJ, OR, OP, ACC, VEL
 

@@ -12,7 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import inline, kernel, scratch
+from numba import boolean, int64, types
+
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, fast, inline, scratch
 from ..layout import IQ, IV, JTYPE, MOTION, NDOF, PARENT, UNIT_AXIS
 from ..joint_kernels import body_placement
 from ..spatial import compose, cross_into, motion_act
@@ -20,8 +22,10 @@ from ..coupling import expand_q, is_coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
-from .status import BAD_QUATERNION, NONFINITE, finite, finite2, result_status
-from .driver import batch_kernel, chunks
+from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
+from ._inputs import unpack
+from ._workspace import row
+from .driver import batch_kernel
 
 
 @inline
@@ -95,12 +99,6 @@ def workspace(nb):
     return np.empty((nb, 3, 3)), np.empty((nb, 3)), np.empty((3, 3)), np.empty(3)
 
 
-@kernel
-def _fk_single(ints, body, q, oR, op, check):
-    liR, lip, Rj, pj = workspace(ints.shape[0])
-    return poses_checked(ints, body, q, q[:0], check, liR, lip, Rj, pj, oR, op)
-
-
 @inline
 def fk_at(args, s, ws):
     """The world placements of state ``s`` of a batch."""
@@ -109,7 +107,21 @@ def fk_at(args, s, ws):
     return poses_checked(ints, body, Q[s], Q[s, :0], check, liR, lip, Rj, pj, OR[s], OP[s])
 
 
-_fk_batch = batch_kernel(fk_at, workspace)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, types.Array(types.float64, 4, "C"), TENSOR, boolean), (int64,))
+_fk_batch = batch_kernel(fk_at, workspace, one_state=ONE_STATE)
+_fk_call_one = _fk_batch.call_one
+
+
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, boolean, TENSOR, MAT)
+def _fk_packed(address, ints, packed, q, check, oR, op):
+    """One state's world placements ``oR`` (nb, 3, 3), ``op`` (nb, 3) (the fast path): the
+    batch's code at ``address`` (``_fk_batch.one_address``) for a batch of one."""
+    body = unpack(ints, packed)[0]
+    nb = ints.shape[0]
+    if not (oR.shape[0] == nb and op.shape[0] == nb):
+        return WRONG_SIZE
+    return _fk_call_one(address, (ints, body, row(q), row(oR), row(op), check), workspace(nb))
 
 
 def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> tuple[np.ndarray, np.ndarray]:
@@ -117,17 +129,19 @@ def world_poses(model, q: np.ndarray, batch: tuple, check: bool, what: str) -> t
     (of a coupled model: the full tree's at ``E(q)``)."""
     if is_coupled(model):
         return world_poses(model.full, expand_q(model, q), batch, check, what)
-    ints, body = model.kernel.ints, model.kernel.body
-    nb = model.nbodies
+    k, nb = model.kernel, model.nbodies
     if batch == ():
         oR, op = np.empty((nb, 3, 3)), np.empty((nb, 3))
-        status = _fk_single(ints, body, q, oR, op, check)
-    else:
-        B = q.shape[0]
-        oR, op, status = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3)), np.empty(B, dtype=np.int64)
-        _fk_batch((ints, body, q, oR, op, check), (nb,), status, chunks(B))
+        try:
+            if _fk_packed(_fk_batch.one_address, k.ints, k.packed[False, False], q, check, oR, op) == OK:
+                return oR, op
+        except TypeError:  # not a contiguous float64 vector (or check not a bool): the general path
+            pass
+    B = 1 if batch == () else q.shape[0]
+    oR, op, status = np.empty((B, nb, 3, 3)), np.empty((B, nb, 3)), np.empty(B, dtype=np.int64)
+    _fk_batch.run((k.ints, k.body, _inputs.batched(batch, q)[0], oR, op, check), (nb,), status, batch)
     raise_for_status(model, status, {"q": q}, what)
-    return oR, op
+    return (oR[0], op[0]) if batch == () else (oR, op)
 
 
 def _homogeneous(R: np.ndarray, p: np.ndarray) -> np.ndarray:

@@ -34,7 +34,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import core, inline, kernel, scratch
+from numba import boolean, int64
+
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
 from ..layout import INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SUBTREE_END
 from ..joint_kernels import local_placement, nq_of
 from ..spatial import (congruence_shift, inertia_matrix, inertia_rotated, rotate6, shifted_motion, unshifted_force,
@@ -45,9 +47,10 @@ from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status, raise_singular
 from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, finite2, result_status
+from ._inputs import matrix_one_state
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from .aba import aligned_placement, articulated_inertia, joint_acceleration, joint_inertia
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 
 @scratch
@@ -227,12 +230,18 @@ def minv_at(args, s, ws):
     return minv_one(ints, body, dofs, Q[s], check, MM[s], ws)
 
 
-_minv_batch = batch_kernel(minv_at, workspace)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, MAT, boolean, TENSOR), (int64, int64))
+_minv_batch = batch_kernel(minv_at, workspace, one_state=ONE_STATE)
+_minv_call_one = _minv_batch.call_one
 
 
-@kernel
-def _minv_single(ints, body, dofs, q, check, Minv):
-    return minv_one(ints, body, dofs, q, check, Minv, workspace(ints.shape[0], dofs.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, boolean, MAT)
+def _minv_packed(address, ints, packed, q, check, Minv):
+    """One state, the model in one array (the fast path): the batch's code at ``address``
+    (``_minv_batch.one_address``) for a batch of one."""
+    ok, args = matrix_one_state(ints, packed, q, check, Minv)
+    return _minv_call_one(address, args, workspace(ints.shape[0], Minv.shape[0])) if ok else WRONG_SIZE
 
 
 def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool = True) -> np.ndarray:
@@ -246,30 +255,25 @@ def inverse_mass_matrix(model, q, *, armature: bool = True, check_finite: bool =
     articulated inertia is singular (``M`` is then singular too). Reference: Carpentier and
     Mansard, RSS 2018 (Pinocchio's ``computeMinverse``); RBDA Table 7.1.
     """
-    if _inputs.vectors(q):
-        Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
-        try:
-            k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-            if _minv_single(k.ints, k.body, k.dofs[(False, bool(armature))], q, check_finite, Minv) == OK:
-                return Minv
-        except AttributeError:
-            pass
+    Minv = np.empty((model.nv, model.nv))  # fast path for one state: the kernel checks q
+    try:
+        k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
+        if _minv_packed(_minv_batch.one_address, k.ints, k.packed[False, armature], q, check_finite, Minv) == OK:
+            return Minv
+    except (TypeError, KeyError, AttributeError):  # not a contiguous float64 vector (or armature not bool)
+        pass
     if any_lazy(q):
         return deferred(inverse_mass_matrix, locals())
     if is_coupled(model):  # mimic joints: the inverse of G^T M_full G
         L = coupled.cholesky(coupled.mass_matrix(model, q, armature, check_finite), model, "inverse_mass_matrix")
         return coupled.solve(L, np.broadcast_to(np.eye(model.nv), L.shape))
     k = model.kernel
-    dofs = k.dofs[(False, bool(armature))]
     batch, x = _inputs.states(model, q=q)
-    q = x["q"]
-    if batch == ():
-        Minv = np.empty((model.nv, model.nv))
-        status = _minv_single(k.ints, k.body, dofs, q, check_finite, Minv)
-    else:
-        B = q.shape[0]
-        Minv, status = np.empty((B, model.nv, model.nv)), np.empty(B, dtype=np.int64)
-        _minv_batch((k.ints, k.body, dofs, q, check_finite, Minv), (model.nbodies, model.nv), status, chunks(B))
+    Minv, result = _inputs.output(None, batch, (model.nv, model.nv), x)
+    Q, MI = _inputs.batched(batch, x["q"], Minv)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    _minv_batch.run((k.ints, k.body, k.dofs[(False, bool(armature))], Q, check_finite, MI),
+                    (model.nbodies, model.nv), status, batch)
     raise_singular(model, raise_for_status(model, status, x, "inverse_mass_matrix"), "inverse_mass_matrix",
                    "so M(q) is singular")
-    return _inputs.unflatten(Minv, batch)
+    return result

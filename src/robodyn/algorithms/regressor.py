@@ -49,7 +49,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._deprecated import renamed_keywords
-from .._jit import core, inline, kernel, scratch
+from .._jit import core, inline, scratch
 from ..layout import IQ, IV, MOTION, NDOF, PARAMS_SIZE, PARENT, SMOOTHING
 from ..spatial import dot6, force_act, force_cross, inertia_mul, motion_act_inv, motion_cross
 from ..coupling import expand_q, expand_v, is_coupled, reduce_rows
@@ -59,7 +59,7 @@ from .status import raise_for_status
 from .status import NONFINITE, OK, finite, finite2, result_status
 from .kinematics import poses_checked
 from .rnea import base_acceleration, motion_pass
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 EXTRA_COLUMNS = ("damping", "coulomb", "stiffness", "armature", "offset")
 # The flags of the extra columns follow the model's ``params`` in the kernels' ``params``.
@@ -162,11 +162,6 @@ def regressor_at(args, s, ws):
 _regressor_batch = batch_kernel(regressor_at, workspace)
 
 
-@kernel
-def _regressor_single(ints, body, dofs, params, q, v, a, check, Y):
-    return regressor_one(ints, body, dofs, params, q, v, a, check, Y, workspace(ints.shape[0], dofs.shape[0]))
-
-
 @scratch
 def reference_workspace(nb, nv):
     """:func:`workspace` plus the reference velocities (nb, 6) and two 6-vectors."""
@@ -259,12 +254,6 @@ def slotine_li_at(args, s, ws):
 _slotine_li_batch = batch_kernel(slotine_li_at, reference_workspace)
 
 
-@kernel
-def _slotine_li_single(ints, body, dofs, params, q, v, v_r, a_r, check, Y):
-    return slotine_li_regressor_one(ints, body, dofs, params, q, v, v_r, a_r, check, Y,
-                                    reference_workspace(ints.shape[0], dofs.shape[0]))
-
-
 @core
 def energy_regressor_one(ints, body, dofs, grav, q, v, check, out, ws):
     """``out[0]`` kinetic-energy regressor (when ``v`` has entries), ``out[1]`` potential.
@@ -299,11 +288,6 @@ def energy_regressor_at(args, s, ws):
 
 
 _energy_regressor_batch = batch_kernel(energy_regressor_at, workspace)
-
-
-@kernel
-def _energy_regressor_single(ints, body, dofs, grav, q, v, check, out):
-    return energy_regressor_one(ints, body, dofs, grav, q, v, check, out, workspace(ints.shape[0], dofs.shape[0]))
 
 
 @renamed_keywords(viscous="damping")
@@ -392,12 +376,8 @@ def regressor(model, q, v, a, *, damping: bool = False, coulomb: bool = False, s
     Q, V, A = (_inputs.as_batch(x[n]) for n in "qva")
     B = Q.shape[0]
     Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
-    if batch == ():  # one state: no parallel launch
-        status[0] = _regressor_single(k.ints, k.body, k.dofs[(False, False)], params, Q[0], V[0], A[0],
-                                      check_finite, Y[0])
-    else:
-        _regressor_batch((k.ints, k.body, k.dofs[(False, False)], params, Q, V, A, check_finite, Y),
-                         (model.nbodies, model.nv), status, chunks(B))
+    _regressor_batch.run((k.ints, k.body, k.dofs[(False, False)], params, Q, V, A, check_finite, Y),
+                         (model.nbodies, model.nv), status, batch)
     raise_for_status(model, status, x, "regressor")
     return Y[0] if batch == () else Y.reshape(batch + Y.shape[1:])
 
@@ -455,16 +435,11 @@ def slotine_li_regressor(model, q, v, v_ref, a_ref, *, damping: bool = False, co
     params = np.concatenate([k.params[True], flags])
     ncol = 10 * model.nbodies + model.nv * int(sum(flags))
     args = (k.ints, k.body, k.dofs[(False, False)], params)
-    if batch == ():
-        Y = np.empty((model.nv, ncol))
-        status = _slotine_li_single(*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y)
-    else:
-        B = x["q"].shape[0]
-        Y, status = np.empty((B, model.nv, ncol)), np.empty(B, dtype=np.int64)
-        _slotine_li_batch((*args, x["q"], x["v"], x["v_ref"], x["a_ref"], check_finite, Y),
-                          (model.nbodies, model.nv), status, chunks(B))
+    Q, V, VR, AR = _inputs.batched(batch, x["q"], x["v"], x["v_ref"], x["a_ref"])
+    Y, status = np.empty((Q.shape[0], model.nv, ncol)), np.empty(Q.shape[0], dtype=np.int64)
+    _slotine_li_batch.run((*args, Q, V, VR, AR, check_finite, Y), (model.nbodies, model.nv), status, batch)
     raise_for_status(model, status, x, "slotine_li_regressor")
-    return _inputs.unflatten(Y, batch)
+    return Y.reshape(batch + Y.shape[1:])
 
 
 def _energy(model, check_finite, what, **arrays):
@@ -478,10 +453,8 @@ def _energy(model, check_finite, what, **arrays):
     B = Q.shape[0]
     OUT, status = np.empty((B, 2, 10 * model.nbodies)), np.empty(B, dtype=np.int64)
     args = (k.ints, k.body, k.dofs[(False, False)], model.gravity)
-    if B == 1:  # one state: no thread start-up of the batch driver
-        status[0] = _energy_regressor_single(*args, Q[0], V[0], check_finite, OUT[0])
-    else:
-        _energy_regressor_batch((*args, Q, V, check_finite, OUT), (model.nbodies, model.nv), status, chunks(B))
+    _energy_regressor_batch.run((*args, Q, V, check_finite, OUT), (model.nbodies, model.nv), status,
+                                () if B == 1 else (B,))
     raise_for_status(model, status, x, what)
     return OUT.reshape(batch + OUT.shape[1:])
 

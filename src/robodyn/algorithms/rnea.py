@@ -20,7 +20,7 @@ import numpy as np
 from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel, scratch
+from .._jit import INTS, MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, MOTION, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import body_placement, nq_of, passive_torque
 from ..spatial import (force_act, force_cross, inertia_mul, momentum, motion_act_inv, motion_cross, motion_cross_unit,
@@ -31,10 +31,10 @@ from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import fits, unpack
-from .status import BAD_QUATERNION, NONFINITE, NO_WRENCH, OK, WRONG_SIZE, finite, result_status
+from ._inputs import coupled_one_state, one_state
+from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, result_status
 from .kinematics import world_placement
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 
 
 @inline
@@ -52,9 +52,16 @@ def workspace_views(buf, nb):
 
 
 @scratch
+def buffer(nb):
+    """``(buffer,)``: the memory of :func:`workspace`, the workspace of the batch code (which
+    carves the views once per chunk, :func:`rnea_views`)."""
+    return (np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18),)
+
+
+@scratch
 def workspace(nb):
     """Scratch of :func:`rnea_one`: ``(buffer, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2)``."""
-    buf = np.empty((POSES_SIZE_NB + 18) * nb + POSES_SIZE + 18)
+    buf = buffer(nb)[0]
     return (buf,) + workspace_views(buf, nb)
 
 
@@ -123,8 +130,9 @@ def rnea_state(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, ws):
     """Inverse dynamics of one state into ``tau`` (nv,); returns a status (see ``_inputs``).
 
     ``params = [gravity (3), Coulomb smoothing]``; ``fcode < 0``: no external wrench.
-    Inlined into :func:`rnea_one` (one state) and :func:`rnea_at` (a batch loop, where a
-    call per state would cost more than a tenth of the work).
+    Inlined into :func:`rnea_one` (one state, for other kernels) and :func:`rnea_at` (the
+    batch code, which ``rnea`` runs for a single state too, as a batch of one; a call per
+    state would cost more than a tenth of the work).
     """
     _, (liR, lip, oR, op, Rj, pj), vel, acc, f, vJ, t1, t2 = ws
     nb, nv = ints.shape[0], dofs.shape[0]
@@ -187,25 +195,23 @@ def rnea_at(args, s, ws):
 
 @inline
 def rnea_views(args, ws):
-    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    """The workspace views carved once per chunk from the buffer, where the compiler sees
+    their shapes."""
     return (ws[0],) + workspace_views(ws[0], args[0].shape[0])
 
 
-_rnea_batch = batch_kernel(rnea_at, workspace, rnea_views)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, MAT), (int64,))
+_rnea_batch = batch_kernel(rnea_at, buffer, rnea_views, ONE_STATE)
+_rnea_call_one = _rnea_batch.call_one
 
 
-@kernel
-def _rnea_single(ints, body, dofs, params, q, v, a, fext, fcode, check, tau):
-    return rnea_one(ints, body, dofs, params, q, v, a, fext, fcode, check, tau, workspace(ints.shape[0]))
-
-
-@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
-def _rnea_packed(ints, packed, q, v, a, check, tau):
-    """One state without external wrenches, the model in one array (the fast path)."""
-    body, dofs, params, zero = unpack(ints, packed)
-    if not fits(tau, dofs.shape[0], q, v, a):
-        return WRONG_SIZE
-    return rnea_state(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
+def _rnea_packed(address, ints, packed, q, v, a, check, tau):
+    """One state without external wrenches, the model in one array (the fast path): the
+    batch's code at ``address`` (``_rnea_batch.one_address``) for a batch of one."""
+    ok, args = one_state(ints, packed, q, v, a, check, tau)
+    return _rnea_call_one(address, args, buffer(ints.shape[0])) if ok else WRONG_SIZE
 
 
 @scratch
@@ -246,17 +252,19 @@ def rnea_coupled_at(args, s, ws):
                               F[s if F.shape[0] > 1 else 0], fcode, check, TAU[s], ws)
 
 
-_rnea_coupled_batch = batch_kernel(rnea_coupled_at, coupled_workspace)
+COUPLED_ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, INTS, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, MAT),
+                     (int64, int64, int64))
+_rnea_coupled_batch = batch_kernel(rnea_coupled_at, coupled_workspace, one_state=COUPLED_ONE_STATE)
+_rnea_coupled_call_one = _rnea_coupled_batch.call_one
 
 
-@fast(MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, MAT, int64, boolean, VEC)
-def _rnea_coupled_one(ints, packed, cints, cfloats, q, v, a, fext, fcode, check, tau):
-    """One state of a coupled model (``fcode < 0``: no external wrench, ``fext`` unread)."""
-    body, dofs, params, _ = unpack(ints, packed)
-    if not fits(tau, cints[1], q, v, a):
-        return WRONG_SIZE
-    return rnea_coupled_state(ints, body, dofs, params, cints, cfloats, q, v, a, fext, fcode, check, tau,
-                              coupled_workspace(ints.shape[0], nq_of(ints), dofs.shape[0]))
+@fast(int64, MODEL_INTS, MODEL_PACKED, INTS, VEC, VEC, VEC, VEC, boolean, VEC)
+def _rnea_coupled_one(address, ints, packed, cints, cfloats, q, v, a, check, tau):
+    """One state of a coupled model without external wrenches: the batch's code at ``address``
+    (``_rnea_coupled_batch.one_address``) for a batch of one."""
+    ok, args = coupled_one_state(ints, packed, cints, cfloats, q, v, a, check, tau)
+    return (_rnea_coupled_call_one(address, args, coupled_workspace(ints.shape[0], nq_of(ints), args[2].shape[0]))
+            if ok else WRONG_SIZE)
 
 
 def run_coupled(model, q, v, a, f_ext, frame: str, friction: bool, armature: bool, check: bool, out=None):
@@ -273,14 +281,11 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
     (see ``_inputs.output``); errors name the arrays of ``report`` (default ``x``)."""
     k = model.kernel
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[gravity]
-    q, v, a = x["q"], x["v"], x["a"]
     tau, result = _inputs.output(out, batch, (model.nv,), x)
-    if batch == ():
-        status = _rnea_single(k.ints, k.body, dofs, params, q, v, a, F, fcode, check, tau)
-    else:
-        status = np.empty(q.shape[0], dtype=np.int64)
-        _rnea_batch((k.ints, k.body, dofs, params, q, v, a, F, fcode, check, tau), (model.nbodies,), status,
-                    chunks(q.shape[0]))
+    Q, V, A, F, TAU = _inputs.batched(batch, x["q"], x["v"], x["a"], F, tau)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    args = (k.ints, k.body, dofs, params, Q, V, A, F, fcode, check, TAU)
+    _rnea_batch.run(args, (model.nbodies,), status, batch)
     raise_for_status(model, status, x if report is None else report, what)
     return result
 
@@ -328,7 +333,8 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
         tau = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks sizes and values
         try:
             k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-            if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
+            if _rnea_packed(_rnea_batch.one_address, k.ints, k.packed[friction, armature], q, v, a, check_finite,
+                            tau) == OK:
                 return tau
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass

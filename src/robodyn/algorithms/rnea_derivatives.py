@@ -51,10 +51,10 @@ algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Tab
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean
+from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, kernel
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, kernel, scratch
 from ..joint_kernels import nq_of, passive_torque_dv
 from ..layout import ARMATURE, IV, NDOF, PARENT, SMOOTHING, STIFFNESS, SUBTREE_END
 from ..spatial import (dot6, force_act, force_cross, inertia_matrix, inertia_mul, matTvec6, matvec6, momentum,
@@ -63,9 +63,9 @@ from ..coupling import expand_q, expand_v, is_coupled, reduce_matrix
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from ._inputs import fits, unpack
-from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, row, take
 from .crba import world_state
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 from .rnea import base_acceleration
 from .status import NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, finite2, raise_for_status, result_status
 
@@ -93,11 +93,18 @@ def workspace_views(buf, nb, nv):
     return P, (Ic, ov, oa, of, W, turn, dY, mark), cols, (Ym, A, t)
 
 
+@scratch
+def buffer(nb, nv):
+    """``(buffer,)``: the memory of :func:`workspace`, the workspace of the batch code (which
+    carves the views once per chunk, :func:`derivatives_views`)."""
+    return (np.empty((POSES_SIZE_NB + PER_BODY) * nb + PER_DOF * nv + POSES_SIZE + 72 + 18),)
+
+
 @kernel
 def workspace(nb, nv):
     """Scratch of :func:`derivatives_one`: ``(buffer, poses, per-body arrays, per-dof columns,
     small scratch)``, views of the buffer."""
-    buf = np.empty((POSES_SIZE_NB + PER_BODY) * nb + PER_DOF * nv + POSES_SIZE + 72 + 18)
+    buf = buffer(nb, nv)[0]
     return (buf,) + workspace_views(buf, nb, nv)
 
 
@@ -337,39 +344,41 @@ def derivatives_at(args, s, ws):
 
 @inline
 def derivatives_views(args, ws):
-    """The workspace views rebuilt once per chunk, where the compiler sees their shapes."""
+    """The workspace views carved once per chunk from the buffer, where the compiler sees
+    their shapes."""
     return (ws[0],) + workspace_views(ws[0], args[0].shape[0], args[2].shape[0])
 
 
-_derivatives_batch = batch_kernel(derivatives_at, workspace, derivatives_views)
+# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
+ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, TENSOR, TENSOR, TENSOR),
+             (int64, int64))
+_derivatives_batch = batch_kernel(derivatives_at, buffer, derivatives_views, ONE_STATE)
+_derivatives_call_one = _derivatives_batch.call_one
 
 
-@kernel
-def _derivatives_single(ints, body, dofs, params, q, v, a, fext, fcode, check, dq, dv, M):
-    return derivatives_one(ints, body, dofs, params, q, v, a, fext, fcode, check, dq, dv, M,
-                           workspace(ints.shape[0], dofs.shape[0]))
-
-
-@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, MAT, MAT, MAT)
-def _derivatives_packed(ints, packed, q, v, a, check, dq, dv, M):
-    """One state without external wrenches, the model in one array (the fast path)."""
+@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, MAT, MAT, MAT)
+def _derivatives_packed(address, ints, packed, q, v, a, check, dq, dv, M):
+    """One state without external wrenches, the model in one array (the fast path): the
+    batch's code at ``address`` (``_derivatives_batch.one_address``) for a batch of one."""
     body, dofs, params, zero = unpack(ints, packed)
     nv = dofs.shape[0]
     if not (fits(dq, nv, q, v, a) and fits(dv, nv, q, v, a) and fits(M, nv, q, v, a)):
         return WRONG_SIZE
-    return derivatives_one(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, dq, dv, M,
-                           workspace(ints.shape[0], nv))
+    args = (ints, body, dofs, params, row(q), row(v), row(a), row(zero), int64(NO_WRENCH), check, row(dq), row(dv),
+            row(M))
+    return _derivatives_call_one(address, args, buffer(ints.shape[0], nv))
 
 
-def fast_path(packed, model, q, v, x, friction, armature, check):
+def fast_path(packed, batch, model, q, v, x, friction, armature, check):
     """The three (nv, nv) results of the fast-path kernel ``packed`` (see ``_jit.fast``) for one
-    state without external wrenches, or None when it does not take the arguments (then the
-    general path checks them and says what is wrong; a CoupledModel, which has no kernel)."""
+    state without external wrenches, which runs the code of the batch kernel ``batch`` at its
+    ``one_address``, or None when it does not take the arguments (then the general path checks
+    them and says what is wrong; a CoupledModel, which has no kernel)."""
     nv = model.nv
     out = np.empty((nv, nv)), np.empty((nv, nv)), np.empty((nv, nv))
     try:
         k = model.kernel
-        if packed(k.ints, k.packed[friction, armature], q, v, x, check, *out) == OK:
+        if packed(batch.one_address, k.ints, k.packed[friction, armature], q, v, x, check, *out) == OK:
             return out
     except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
         pass
@@ -403,7 +412,7 @@ def rnea_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *, fricti
     if f_ext_frame is not None:  # the old spelling of ``frame``
         frame = renamed_keyword("f_ext_frame", f_ext_frame, "frame", frame, "rnea_derivatives()")
     if f_ext is None and frame in _inputs.WRENCH_FRAMES:
-        out = fast_path(_derivatives_packed, model, q, v, a, friction, armature, check_finite)
+        out = fast_path(_derivatives_packed, _derivatives_batch, model, q, v, a, friction, armature, check_finite)
         if out is not None:
             return out
     if is_coupled(model):  # mimic joints: G^T D_full G at (E(q), G v, G a)
@@ -424,11 +433,9 @@ def run(model, batch, x, F, fcode, check, gravity=True, friction=True, armature=
     dofs, params = k.dofs[(bool(friction), bool(armature))], k.params[bool(gravity)]
     (dq, rq), (dv, rv) = (_inputs.output(None, batch, (nv, nv), x) for _ in range(2))
     M, rM = _inputs.output(None, batch, (nv, nv) if mass else (0, 0), x)
-    if batch == ():
-        status = _derivatives_single(k.ints, k.body, dofs, params, x["q"], x["v"], x["a"], F, fcode, check, dq, dv, M)
-    else:
-        status = np.empty(x["q"].shape[0], dtype=np.int64)
-        _derivatives_batch((k.ints, k.body, dofs, params, x["q"], x["v"], x["a"], F, fcode, check, dq, dv, M),
-                           (model.nbodies, nv), status, chunks(status.shape[0]))
+    Q, V, A, F, DQ, DV, MM = _inputs.batched(batch, x["q"], x["v"], x["a"], F, dq, dv, M)
+    status = np.empty(Q.shape[0], dtype=np.int64)
+    args = (k.ints, k.body, dofs, params, Q, V, A, F, fcode, check, DQ, DV, MM)
+    _derivatives_batch.run(args, (model.nbodies, nv), status, batch)
     raise_for_status(model, status, x if report is None else report, what)
     return rq, rv, rM

@@ -59,7 +59,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .._jit import core, inline, kernel, scratch
+from .._jit import core, inline, scratch
 from ..spatial import force_act, inertia_act, inertia_matrix, motion_act
 from ..layout import (COULOMB, GRAVITY, INERTIA, INERTIA_END, IV, MOTION, NDOF, PARENT, SMOOTHING, STRIBECK,
                       STRIBECK_RATE)
@@ -67,7 +67,7 @@ from ..coupling import expand_q, expand_v, is_coupled
 from ._lazy import any_lazy, deferred
 from . import _inputs
 from .kinematics import world_poses
-from .driver import batch_kernel, chunks
+from .driver import batch_kernel
 from .status import NONFINITE, OK, raise_for_status, require_finite_result
 
 WHAT = "rnea_second_derivatives"
@@ -188,21 +188,10 @@ BLOCKS = np.array([[Q_DIR, Q_DIR], [Q_DIR, V_DIR], [Q_DIR, A_DIR], [V_DIR, V_DIR
 TARGET = np.array([[0, 0], [1, 1], [3, 0], [2, 0]], dtype=np.int64)
 
 
-@kernel
-def _state(tree, S, theta, oR, op, f, fcode, v, a, a0, out):
-    """``out`` (4, nv, nv, nv): the four tensors (rigid-body part) at one state, from the world
-    placements ``oR`` (nb, 3, 3), ``op`` (nb, 3) of the bodies, the motion subspaces ``S`` (nv,
-    6) and inertial parameters ``theta`` (nb, 10) in the body frames, the external wrenches
-    ``f`` (nb, 6) in the frame of ``fcode`` (``_inputs.body_wrenches``; ignored for -1), ``v``,
-    ``a`` and the base acceleration ``a0``; ``tree = (parent, body_of, iv, nd, anc)``.
-    Allocates the workspace of :func:`_passes`."""
-    _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, *_workspace(oR.shape[0], S.shape[0]))
-
-
 @scratch
 def _workspace(nb, nv):
-    """The scratch arrays of :func:`_passes`, zeros: one per state of :func:`_state`, one per
-    worker of the batch driver (which zeroes them again for every state: :func:`_state_at`)."""
+    """The scratch arrays of :func:`_passes`, zeros: one per worker of the batch driver (which
+    zeroes them again for every state: :func:`_state_at`)."""
     return (np.zeros((nv, 6)), np.zeros((nb, 6, 6)), np.zeros((nb, 6)), np.zeros((nb, 3)), np.zeros(10),
             np.zeros((9, nb, 6)), np.zeros((nv, nb, 6, 6)), np.zeros((2, nv, nb, 6)), np.zeros((3 * nv, nv, 6)),
             np.zeros((5, 3 * nv, nb, 6)), np.zeros((nv, 6)), np.zeros((9, 6)), np.zeros((6, 6)))
@@ -211,7 +200,7 @@ def _workspace(nb, nv):
 @core
 def _passes(tree, S, theta, oR, op, f, fcode, v, a, a0, out, J, Y, W, fw, th, values, LY, LYv, Jx, firsts, Jxy,
             small, X):
-    """:func:`_state` in its workspace (zeros on entry): world columns ``J`` (nv, 6), inertias
+    """One state (:func:`_state_at`) in its workspace (zeros on entry): world columns ``J`` (nv, 6), inertias
     ``Y`` (nb, 6, 6) and wrenches ``W`` (nb, 6) at the world origin, the forces ``fw`` (nb, 3)
     of wrenches about the body origins ``p = op``, ``th`` (10,); ``values`` (9, nb, 6), ``LY``
     (nv, nb, 6, 6), ``LYv`` (2, nv, nb, 6), ``Jx`` (3 nv, nv, 6), ``firsts`` (5, 3 nv, nb, 6),
@@ -560,12 +549,9 @@ def rnea_second_derivatives(model, q, v, a, f_ext=None, frame: str = "local", *,
     a0 = np.concatenate([-k.params[True][GRAVITY:GRAVITY + 3], np.zeros(3)])
     res = np.empty((B, 4, nv, nv, nv))
     F = F if F.flags.writeable else F.copy()  # the kernels are compiled for writeable arrays (see layout)
-    if batch == ():  # one state: no threads to start
-        _state(_tree(model), S, theta, oR, op, F, np.int64(fcode), V[0], A[0], a0, res[0])
-    else:
-        status = np.empty(B, dtype=np.int64)
-        _batch(_tree(model) + (S, theta, oR, op, F, np.int64(fcode), V, A, a0, res), (model.nbodies, nv), status,
-               chunks(B))
+    oR, op, F = _inputs.batched(batch, oR, op, F)
+    _batch.run(_tree(model) + (S, theta, oR, op, F, np.int64(fcode), V, A, a0, res), (model.nbodies, nv),
+               np.empty(B, dtype=np.int64), batch)
     out = [res[0, t] if batch == () else np.ascontiguousarray(res[:, t]) for t in range(4)]
     if friction and nv:
         with np.errstate(all="ignore"):  # NaN/Inf when check_finite=False: the check below says so

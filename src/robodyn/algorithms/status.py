@@ -83,21 +83,24 @@ def require_finite_result(what: str, out: np.ndarray, check: bool, arrays: dict)
     return out
 
 
+def first_failure(status) -> int:
+    """The status of the first state that failed (``OK`` when none did) of an int or an int
+    array (a single state's array of one entry read as quickly as an int)."""
+    if type(status) is int:
+        return status
+    if status.shape == (1,):
+        return int(status[0])
+    bad = np.flatnonzero(status)
+    return int(status[bad[0]]) if bad.size else OK
+
+
 def raise_for_status(model, status, arrays: dict, what: str) -> int:
     """Raise the ``ValueError`` a kernel status stands for; return the failing body + 1 (or 0).
 
-    ``status`` is an int (single state) or an int array (batch); ``arrays`` are the inputs as
+    ``status`` is an int or an int array (a status per state); ``arrays`` are the inputs as
     given to the kernel, used to say where the problem is.
     """
-    if type(status) is int:
-        if status == OK:
-            return 0
-        code = status
-    else:
-        bad = np.flatnonzero(status)
-        if bad.size == 0:
-            return 0
-        code = int(status[bad[0]])
+    code = first_failure(status)
     if code == OK:
         return 0
     if code == WRONG_SIZE:
@@ -144,9 +147,7 @@ def raise_for_coupled(model, status, arrays: dict, what: str) -> int:
     mimic joints, so its entries are the caller's, named by their index there); a non-finite
     input of the full tree from finite independent coordinates is an overflow of ``P q + o``
     or ``G v``, a non-finite result."""
-    if type(status) is not int:
-        bad = np.flatnonzero(status)
-        status = int(status[bad[0]]) if bad.size else OK
+    status = first_failure(status)
     if status == BAD_QUATERNION:  # q[k] of the full tree is q[column[k]] of the caller's
         column = dict(zip(model.independent_q.tolist(), range(model.nq)))
         raise_bad_unit(model.full, arrays["q"] @ model.P.T + model.offset, what, column.__getitem__)
