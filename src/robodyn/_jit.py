@@ -44,15 +44,24 @@ zero give inf/nan instead of raising (the kernels check their inputs and pivots 
 finiteness checks stay exact.
 """
 
+import base64
 import contextlib
+import ctypes
+import importlib
+import inspect
 import itertools
 import os
+import pickle
 import sys
 import threading
 
+from llvmlite import binding as _llvm
+from llvmlite import ir as _ir
 from numba import njit
 from numba import types as _types
+from numba.core import cgutils as _cgutils
 from numba.core.caching import FunctionCache, IndexDataCacheFile
+from numba.extending import intrinsic as _intrinsic
 
 try:
     import fcntl
@@ -197,3 +206,94 @@ class _FirstCall:
                 name = self.__wrapped__.__name__
                 if getattr(module, name, None) is self:
                     setattr(module, name, self.dispatcher)  # the module's later calls go straight to it
+
+
+# -- calls by address ---------------------------------------------------------------------------
+#
+# Numba copies every compiled function a kernel calls into the kernel's module, to be optimised
+# and emitted again there, transitively: a large function called from several kernels (the
+# ABA of a simulation step, the contact step of a rollout) is compiled once more inside each.
+# :func:`by_address` calls it at the address of its own compiled code instead. The caller's
+# module holds a cell for the address (null when it is loaded, from the compiler or the
+# on-disk cache) and the key of the callee (its module, name, argument and return types); the
+# first call in a process asks :func:`_resolve` (a C callback into Python, registered with
+# LLVM under ``RESOLVE``) for the address, which compiles or loads the callee then, and keeps
+# it in the cell. So a cached caller needs nothing before it is loaded, and the callee's code
+# is its current one.
+
+RESOLVE = "robodyn_resolve_address"
+
+
+def _resolve(key: bytes) -> int:
+    """The address of the compiled code that ``key`` names (``module|qualname|types``, see
+    :func:`by_address`), compiled or loaded now; 0 when it cannot be had (the module or name
+    is gone, or its return type is no longer the one the caller was compiled against: a
+    stale cache), which the caller raises as an error."""
+    try:
+        module, qualname, blob = key.split(b"|", 2)
+        callee = importlib.import_module(module.decode())
+        for part in qualname.decode().split("."):
+            callee = getattr(callee, part)
+        args, restype = pickle.loads(base64.b64decode(blob))
+        callee.compile(args)
+        compiled = callee.overloads[args]
+        if compiled.signature.return_type != restype:
+            return 0
+        return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
+    except Exception:  # noqa: BLE001 (a C callback must not raise: the caller reports the 0)
+        return 0
+
+
+_RESOLVE_CALLBACK = ctypes.CFUNCTYPE(ctypes.c_void_p, ctypes.c_char_p)(_resolve)
+_llvm.add_symbol(RESOLVE, ctypes.cast(_RESOLVE_CALLBACK, ctypes.c_void_p).value)
+
+
+def by_address(dispatcher):
+    """A function for compiled code that calls ``dispatcher`` (a ``core`` or ``kernel``
+    function, reachable by its module and qualified name) at the address of its compiled
+    code, compiled for the argument types of the call (without their literal values), instead
+    of copying that code into the caller (see above). The call cannot be inlined: meant for
+    large functions, called once per step or state. An address that cannot be resolved raises
+    ``RuntimeError`` in the caller."""
+    py_func = dispatcher.py_func
+    params = list(inspect.signature(py_func).parameters)
+    namespace: dict = {}
+    exec(f"def {py_func.__name__}(typingctx, {', '.join(params)}):\n"  # noqa: S102 (the callee's parameter names)
+         f"    return type_call(({', '.join(params)},))", namespace)
+    name = f"{py_func.__module__}|{py_func.__qualname__}|"
+
+    def type_call(args):
+        args = tuple(_types.unliteral(a) for a in args)
+        dispatcher.compile(args)
+        compiled = dispatcher.overloads[args]
+        restype = compiled.signature.return_type
+        key = (name + base64.b64encode(pickle.dumps((args, restype))).decode()).encode()
+        cell_name = "robodyn.address." + compiled.fndesc.mangled_name
+
+        def codegen(context, builder, signature, llargs):
+            module, pointer = builder.module, _ir.IntType(8).as_pointer()
+            cell = module.globals.get(cell_name)
+            if cell is None:
+                cell = _cgutils.add_global_variable(module, pointer, cell_name)
+                cell.linkage = "internal"
+                cell.initializer = _ir.Constant(pointer, None)
+            with builder.if_then(_cgutils.is_null(builder, builder.load(cell)), likely=False):
+                resolve = _cgutils.get_or_insert_function(module, _ir.FunctionType(pointer, [pointer]), RESOLVE)
+                builder.store(builder.call(resolve, [context.insert_const_bytes(module, key)]), cell)
+            address = builder.load(cell)
+            with builder.if_then(_cgutils.is_null(builder, address), likely=False):
+                context.call_conv.return_user_exc(builder, RuntimeError, (
+                    f"the compiled {py_func.__qualname__} could not be loaded (a stale on-disk cache? "
+                    f"clear Numba's cache)",))
+            callee = builder.bitcast(address, context.call_conv.get_function_type(restype, args).as_pointer())
+            status, result = context.call_conv.call_function(builder, callee, restype, args, llargs)
+            with _cgutils.if_unlikely(builder, status.is_error):
+                context.call_conv.return_status_propagate(builder, status)
+            return result
+
+        return restype(*args), codegen
+
+    namespace["type_call"] = type_call
+    call = _intrinsic(namespace[py_func.__name__])
+    call.dispatcher = dispatcher
+    return call

@@ -35,7 +35,7 @@ import numpy as np
 from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch, splice
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, by_address, core, fast, inline, scratch, splice
 from ..layout import ARMATURE, GRAVITY, INERTIA, INERTIA_END, IQ, IV, JTYPE, NDOF, PARENT, SMOOTHING, UNIT_AXIS
 from ..joint_kernels import local_placement, nq_of, passive_torque
 from ..joints import FREE
@@ -520,14 +520,18 @@ def hybrid_one(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext
     return hybrid_state(ints, body, dofs, params, q, v, qdd_known, tau_known, known, fext, fcode, check, qdd, tau, ws)
 
 
+_hybrid_one = by_address(hybrid_one)
+
+
 @splice
 def aba_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, qdd, ws):
     """Forward dynamics of one state into ``qdd`` (nv,): :func:`hybrid_one` with no joint of
     known acceleration (``ws[18]`` is all False; ``ws[17]`` receives the copy of ``tau``);
-    spliced into its callers, which so call (and copy) the compiled ``hybrid_one`` alone.
+    spliced into its callers, which call the compiled ``hybrid_one`` at its address
+    (``_jit.by_address``: not copied into them).
     Returns a status (see ``_inputs``): ``i + 1`` when the articulated inertia of body ``i``
     is singular."""
-    return hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[18], fext, fcode, check, qdd, ws[17], ws)
+    return _hybrid_one(ints, body, dofs, params, q, v, qdd, tau, ws[18], fext, fcode, check, qdd, ws[17], ws)
 
 
 @inline

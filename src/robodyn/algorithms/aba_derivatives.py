@@ -24,7 +24,7 @@ import numpy as np
 from numba import boolean, int64
 
 from .._deprecated import renamed_keyword
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, by_address, core, fast, inline, scratch
 from ..coupling import is_coupled
 from . import coupled
 from ._lazy import any_lazy, deferred
@@ -110,6 +110,11 @@ def neg_product_t(A, BT, out):
             out[r, c] = -dot_rows(A, r, BT, c, m)
 
 
+# M^-1, the RNEA and its derivatives: called at their compiled code's address, not copied (``_jit``).
+_minv_one, _rnea_one = by_address(_minv.minv_one), by_address(_rnea.rnea_one)
+_rnea_derivatives_one = by_address(_rd.derivatives_one)
+
+
 @core
 def derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_dq, da_dv, Minv, ws):
     """``da_dq``, ``da_dv`` and ``Minv = da_dtau`` (nv, nv) at one state; returns a status (see
@@ -120,12 +125,12 @@ def derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_
         return WRONG_SIZE
     if check and not finite(tau):
         return NONFINITE
-    status = _minv.minv_one(ints, body, dofs, q, check, Minv, minv_ws)
+    status = _minv_one(ints, body, dofs, q, check, Minv, minv_ws)
     if status != OK:
         return status
     for k in range(nv):
         qdd[k] = 0.0
-    status = _rnea.rnea_one(ints, body, dofs, params, q, v, qdd, fext, fcode, check, b, rnea_ws)
+    status = _rnea_one(ints, body, dofs, params, q, v, qdd, fext, fcode, check, b, rnea_ws)
     if status != OK:
         return status
     for r in range(nv):  # qdd = M^-1 (tau - h)
@@ -133,7 +138,7 @@ def derivatives_one(ints, body, dofs, params, q, v, tau, fext, fcode, check, da_
         for k in range(nv):
             s += Minv[r, k] * (tau[k] - b[k])
         qdd[r] = s
-    status = _rd.derivatives_one(ints, body, dofs, params, q, v, qdd, fext, fcode, False, dq, dv, M0, rd_ws)
+    status = _rnea_derivatives_one(ints, body, dofs, params, q, v, qdd, fext, fcode, False, dq, dv, M0, rd_ws)
     if status != OK:
         return status
     transpose(dq)  # dq and dv are scratch: the products read their columns as rows

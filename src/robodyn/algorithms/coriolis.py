@@ -22,9 +22,9 @@ of the first kind ``Gamma_ijk = (dM_ij/dq_k + dM_ik/dq_j - dM_jk/dq_i) / 2``.
 from __future__ import annotations
 
 import numpy as np
-from numba import boolean, int64
+from numba import boolean
 
-from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
+from .._jit import MAT, MODEL_INTS, MODEL_PACKED, VEC, core, fast, inline, scratch
 from ..joint_kernels import nq_of
 from ..layout import IV, NDOF, PARENT
 from ..spatial import dot6, inertia_mul, matTvec6, matvec6, motion_cross, motion_cross_matrix
@@ -33,7 +33,7 @@ from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from .crba import world_state
-from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, row, take
+from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take
 from ._inputs import fits, unpack
 from .status import OK, WRONG_SIZE, finite2, result_status
 from .driver import batch_kernel
@@ -139,21 +139,18 @@ def coriolis_at(args, s, ws):
     return coriolis_one(ints, body, dofs, Q[s], V[s], check, CC[s], ws)
 
 
-# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
-ONE_STATE = ((MODEL_INTS, MAT, MAT, MAT, MAT, boolean, TENSOR), (int64, int64))
-_coriolis_batch = batch_kernel(coriolis_at, workspace, one_state=ONE_STATE)
-_coriolis_call_one = _coriolis_batch.call_one
+_coriolis_batch = batch_kernel(coriolis_at, workspace)
 
 
-@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, boolean, MAT)
-def _coriolis_packed(address, ints, packed, q, v, check, C):
-    """One state, the model in one array (the fast path): the batch's code at ``address``
-    (``_coriolis_batch.one_address``) for a batch of one."""
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, boolean, MAT)
+def _coriolis_packed(ints, packed, q, v, check, C):
+    """One state, the model in one array (the fast path; like the RNEA's, it calls
+    :func:`coriolis_one` directly rather than the batch's code: a call passing the batch's
+    arguments cost 5 % of this one)."""
     body, dofs, _, _ = unpack(ints, packed)
     if not fits(C, dofs.shape[0], q, v, v):
         return WRONG_SIZE
-    return _coriolis_call_one(address, (ints, body, dofs, row(q), row(v), check, row(C)),
-                              workspace(ints.shape[0], dofs.shape[0]))
+    return coriolis_one(ints, body, dofs, q, v, check, C, workspace(ints.shape[0], dofs.shape[0]))
 
 
 def _run(model, batch, x, check, what, out=None):
@@ -181,7 +178,7 @@ def coriolis_matrix(model, q, v, *, check_finite: bool = True, out: np.ndarray |
     C = _inputs.fast_out(out, (model.nv, model.nv))  # fast path for one state: the kernel checks sizes and values
     try:
         k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-        if _coriolis_packed(_coriolis_batch.one_address, k.ints, k.packed[False, False], q, v, check_finite, C) == OK:
+        if _coriolis_packed(k.ints, k.packed[False, False], q, v, check_finite, C) == OK:
             return C
     except (TypeError, AttributeError):  # not contiguous float64 arrays
         pass

@@ -31,8 +31,8 @@ from ._lazy import any_lazy, deferred
 from . import _inputs
 from .status import raise_for_status
 from ._workspace import POSES_SIZE, POSES_SIZE_NB, poses, take, view
-from ._inputs import coupled_one_state, one_state
-from .status import BAD_QUATERNION, NONFINITE, OK, WRONG_SIZE, finite, result_status
+from ._inputs import coupled_one_state, fits, unpack
+from .status import BAD_QUATERNION, NO_WRENCH, NONFINITE, OK, WRONG_SIZE, finite, result_status
 from .kinematics import world_placement
 from .driver import batch_kernel
 
@@ -200,18 +200,20 @@ def rnea_views(args, ws):
     return (ws[0],) + workspace_views(ws[0], args[0].shape[0])
 
 
-# A single state (the fast path) runs the batch's compiled code as a batch of one: these types.
-ONE_STATE = ((MODEL_INTS, MAT, MAT, VEC, MAT, MAT, MAT, TENSOR, int64, boolean, MAT), (int64,))
-_rnea_batch = batch_kernel(rnea_at, buffer, rnea_views, ONE_STATE)
-_rnea_call_one = _rnea_batch.call_one
+_rnea_batch = batch_kernel(rnea_at, buffer, rnea_views)
 
 
-@fast(int64, MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
-def _rnea_packed(address, ints, packed, q, v, a, check, tau):
-    """One state without external wrenches, the model in one array (the fast path): the
-    batch's code at ``address`` (``_rnea_batch.one_address``) for a batch of one."""
-    ok, args = one_state(ints, packed, q, v, a, check, tau)
-    return _rnea_call_one(address, args, buffer(ints.shape[0])) if ok else WRONG_SIZE
+@fast(MODEL_INTS, MODEL_PACKED, VEC, VEC, VEC, boolean, VEC)
+def _rnea_packed(ints, packed, q, v, a, check, tau):
+    """One state without external wrenches, the model in one array (the fast path). Unlike the
+    other fast paths it keeps its own copy of the state code rather than calling the batch's
+    (``driver.BatchKernel.call_one``): the RNEA is the cheapest call, and here the code for
+    external wrenches is cut at compile time and no call passes the arguments (about 0.1 us
+    of 1.7 on the Panda, ``benchmarks/RESULTS.md``)."""
+    body, dofs, params, zero = unpack(ints, packed)
+    if not fits(tau, dofs.shape[0], q, v, a):
+        return WRONG_SIZE
+    return rnea_state(ints, body, dofs, params, q, v, a, zero, NO_WRENCH, check, tau, workspace(ints.shape[0]))
 
 
 @scratch
@@ -333,8 +335,7 @@ def rnea(model, q, v, a, f_ext=None, frame: str = "local", *, friction: bool = T
         tau = _inputs.fast_out(out, (model.nv,))  # fast path for one state: the kernel checks sizes and values
         try:
             k = model.kernel  # a CoupledModel (mimic joints) has none: its path below
-            if _rnea_packed(_rnea_batch.one_address, k.ints, k.packed[friction, armature], q, v, a, check_finite,
-                            tau) == OK:
+            if _rnea_packed(k.ints, k.packed[friction, armature], q, v, a, check_finite, tau) == OK:
                 return tau
         except (TypeError, KeyError, AttributeError):  # not contiguous float64 arrays (or options not bool)
             pass

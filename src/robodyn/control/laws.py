@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._jit import inline, kernel, scratch
+from .._jit import by_address, inline, kernel, scratch
 from ..algorithms.jacobian import jacobian_one
 from ..algorithms.rnea import motion_workspace, rnea_coupled_state, rnea_one
 from ..algorithms.rnea import workspace as rnea_workspace
@@ -86,13 +86,15 @@ def law_torque(law, c, gains, breaks, coefs, t, q, v, tau_cmd, cws, out):
     return law_rnea(c, c[3], q, v, acc, ws, buf, out)
 
 
+_rnea_one = by_address(rnea_one)  # called at its compiled code's address, not copied (see ``_jit``)
+
 @inline
 def law_rnea(c, dofs, q, v, a, ws, buf, out):
     """The RNEA of the controller's model ``c`` (see :func:`law_torque`) with ``dofs``: the
     tree's, or with mimic couplings ``G^T rnea_full(E(q), G v, G a)`` (``buf``: the full
     tree's state, see ``rnea.coupled_workspace``)."""
     if c[6].shape[0] == 0:
-        return rnea_one(c[0], c[1], dofs, c[4], q, v, a, c[5], NO_WRENCH, CHECKED, out, ws)
+        return _rnea_one(c[0], c[1], dofs, c[4], q, v, a, c[5], NO_WRENCH, CHECKED, out, ws)
     return rnea_coupled_state(c[0], c[1], dofs, c[4], c[6], c[7], q, v, a, c[5], NO_WRENCH, CHECKED, out, (ws, buf))
 
 
