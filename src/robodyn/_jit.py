@@ -54,6 +54,7 @@ import os
 import pickle
 import sys
 import threading
+import warnings
 
 from llvmlite import binding as _llvm
 from llvmlite import ir as _ir
@@ -238,9 +239,10 @@ def _resolve(key: bytes) -> int:
         callee.compile(args)
         compiled = callee.overloads[args]
         if compiled.signature.return_type != restype:
-            return 0
+            raise TypeError(f"it returns {compiled.signature.return_type} now, its caller was compiled for {restype}")
         return compiled.library.get_pointer_to_function(compiled.fndesc.llvm_func_name)
-    except Exception:  # noqa: BLE001 (a C callback must not raise: the caller reports the 0)
+    except Exception as e:  # noqa: BLE001 (a C callback must not raise: said here, and the caller raises for the 0)
+        warnings.warn(f"robodyn: no compiled code for {key.split(b'|')[:2]}: {e!r}", RuntimeWarning, stacklevel=1)
         return 0
 
 

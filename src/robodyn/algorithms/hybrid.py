@@ -24,10 +24,9 @@ the joint to the articulated subtree beyond it.
 from __future__ import annotations
 
 import numpy as np
-
-from .._deprecated import renamed_keyword
 from numba import boolean, int64
 
+from .._deprecated import renamed_keyword
 from .._jit import BOOLS, MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, fast, inline
 from .. import joints as J
 from ..coupling import is_coupled

@@ -11,7 +11,6 @@ passes here (``placements``, ``world_placements``) are the first pass of every a
 from __future__ import annotations
 
 import numpy as np
-
 from numba import boolean, int64, types
 
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, fast, inline, scratch

@@ -33,7 +33,6 @@ algorithms", Robotics: Science and Systems, 2018; Featherstone, RBDA (2008), Tab
 from __future__ import annotations
 
 import numpy as np
-
 from numba import boolean, int64
 
 from .._jit import MAT, MODEL_INTS, MODEL_PACKED, TENSOR, VEC, core, fast, inline, scratch
