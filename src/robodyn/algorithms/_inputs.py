@@ -48,17 +48,6 @@ def _as_float(name: str, x) -> np.ndarray:
 _F8 = np.dtype(np.float64)
 
 
-def vectors(*xs) -> bool:
-    """True when every argument is a writeable C-contiguous 1-D float64 ndarray: the
-    single-state fast path, where the kernel itself checks the sizes (status ``WRONG_SIZE``)
-    and values. (The one array type the kernels are compiled for: see :func:`states`.)"""
-    for x in xs:
-        if not (type(x) is np.ndarray and x.ndim == 1 and x.dtype is _F8 and x.flags.c_contiguous
-                and x.flags.writeable):
-            return False
-    return True
-
-
 def states(model, **arrays):
     """Check shapes and bring the state arrays to the kernels' layout.
 
@@ -179,7 +168,7 @@ def fits(out, n, x, y, z):
 @splice
 def one_state(ints, packed, q, v, x, check, out):
     """``(q, v, x) -> out`` (nv,) without external wrenches: ``args = (ints, body, dofs, params,
-    Q, V, X, F, NO_WRENCH, check, OUT)`` (``rnea``, ``aba``)."""
+    Q, V, X, F, NO_WRENCH, check, OUT)`` (``aba``; the RNEA's fast path keeps its own code)."""
     body, dofs, params, zero = unpack(ints, packed)
     return (fits(out, dofs.shape[0], q, v, x),
             (ints, body, dofs, params, row(q), row(v), row(x), row(zero), int64(NO_WRENCH), check, row(out)))

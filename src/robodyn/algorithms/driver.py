@@ -172,7 +172,7 @@ class BatchKernel:
     :meth:`call_one` from a compiled single-state kernel (the fast paths), which gets the
     address, :attr:`one_address`, as an argument."""
 
-    def __init__(self, run_range, workspace, loop, here=None, one_state=None):
+    def __init__(self, run_range, workspace, loop, here, one_state=None):
         self.run_range, self.workspace, self.loop, self.here = run_range, workspace, loop, here
         self.one_state = one_state
         self.call_one = _one_state_call(self)
